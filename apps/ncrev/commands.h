@@ -1,0 +1,43 @@
+// The ncrev command-line tool: each subcommand lives in its own cmd_<name>.cpp and registers
+// itself here. The CLI is thin: it parses options, calls the library, prints, and maps
+// failures to exit codes (0 ok, 1 usage, 2 invalid input, 3 no valid result, 4 cannot write).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace ncrev::cli {
+
+enum ExitCode : int {
+    kExitOk = 0,
+    kExitUsage = 1,
+    kExitBadInput = 2,
+    kExitNoResult = 3,
+    kExitCannotWrite = 4,
+};
+
+/// Shared state of one run: the exit code the chosen subcommand sets.
+struct Context {
+    int exit_code = kExitOk;
+    bool stderr_is_tty = false;
+};
+
+/// A subcommand: `order` sorts them in --help; `add` creates the CLI11 subcommand on `app`
+/// and sets its callback (which stores its exit code in the context).
+struct Command {
+    int order = 0;
+    std::function<void(CLI::App& app, Context& ctx)> add;
+};
+
+/// Registers a subcommand (called from a static initialiser in cmd_<name>.cpp).
+bool register_command(Command command);
+std::vector<Command>& registered_commands();
+
+/// Prints "error: <message>" to stderr.
+void print_error(const std::string& message);
+/// Prints "warning: <message>" to stderr.
+void print_warning(const std::string& message);
+
+}  // namespace ncrev::cli

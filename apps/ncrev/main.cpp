@@ -1,0 +1,59 @@
+// ncrev: machined-part meshes (STL, SRE) back to CAD solids (STEP). The subcommands live in
+// cmd_*.cpp; this file only assembles them and maps failures to exit codes.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+
+#include "commands.h"
+
+namespace ncrev::cli {
+
+std::vector<Command>& registered_commands() {
+    static std::vector<Command> commands;
+    return commands;
+}
+
+bool register_command(Command command) {
+    registered_commands().push_back(std::move(command));
+    return true;
+}
+
+void print_error(const std::string& message) { std::fprintf(stderr, "error: %s\n", message.c_str()); }
+void print_warning(const std::string& message) {
+    std::fprintf(stderr, "warning: %s\n", message.c_str());
+}
+
+}  // namespace ncrev::cli
+
+int main(int argc, char** argv) {
+    using namespace ncrev::cli;
+    CLI::App app{
+        "ncrev turns the triangle mesh of a machined part (STL, or the NC simulator's SRE) back "
+        "into a CAD solid.\nLengths: STL has no unit and is read as millimetres; SRE states its "
+        "unit.\nExit codes: 0 ok (warnings allowed), 1 usage, 2 unreadable or invalid input, 3 "
+        "no valid result, 4 cannot write output.",
+        "ncrev"};
+    app.set_version_flag("--version", "ncrev 0.1.0");
+    app.require_subcommand(1);
+    Context ctx;
+    ctx.stderr_is_tty = ::isatty(2) == 1;
+    auto& commands = registered_commands();
+    std::stable_sort(commands.begin(), commands.end(),
+                     [](const Command& a, const Command& b) { return a.order < b.order; });
+    for (const Command& c : commands) c.add(app, ctx);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return kExitUsage;
+    }
+    return ctx.exit_code;
+}

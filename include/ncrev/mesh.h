@@ -1,0 +1,169 @@
+// mesh: the half-edge triangle mesh, built once from a facet soup with healing
+// (../shared/docs/method.md, Step 1).
+//
+// Storage (manifold's trick): half-edge h belongs to face h/3, next/prev are arithmetic, and
+// only `origin` and `twin` are stored per half-edge; one outgoing half-edge per vertex (the
+// boundary one for a boundary vertex). Every half-edge has at most one twin: non-manifold
+// edges and vertices are split while building. Healing works on the soup before the mesh is
+// built, so the mesh has no deleted elements.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ncrev/common.h"
+#include "ncrev/io.h"
+
+namespace ncrev {
+
+/// A column of values indexed by a strong id.
+template <class IdT, class T>
+class IdMap {
+   public:
+    IdMap() = default;
+    explicit IdMap(std::size_t n, const T& value = T{}) : v_(n, value) {}
+    T& operator[](IdT id) { return v_[id.idx()]; }
+    const T& operator[](IdT id) const { return v_[id.idx()]; }
+    std::size_t size() const { return v_.size(); }
+    std::vector<T>& data() { return v_; }
+    const std::vector<T>& data() const { return v_; }
+
+   private:
+    std::vector<T> v_;
+};
+template <class T>
+using VertexMap = IdMap<VertexId, T>;
+template <class T>
+using FaceMap = IdMap<FaceId, T>;
+template <class T>
+using HalfedgeMap = IdMap<HalfedgeId, T>;
+
+/// A triangle mesh with half-edge connectivity. Built by build_mesh(); immutable afterwards.
+class Mesh {
+   public:
+    std::size_t num_vertices() const { return position_.size(); }
+    std::size_t num_faces() const { return origin_.size() / 3; }
+    std::size_t num_halfedges() const { return origin_.size(); }
+
+    Vec3 position(VertexId v) const { return position_[v.idx()]; }
+    std::span<const Vec3> positions() const { return position_; }
+
+    static FaceId face(HalfedgeId h) { return FaceId(h.idx() / 3); }
+    static HalfedgeId halfedge(FaceId f, int i) { return HalfedgeId(3 * f.idx() + i); }
+    static HalfedgeId next(HalfedgeId h) {
+        return HalfedgeId(h.idx() % 3 == 2 ? h.idx() - 2 : h.idx() + 1);
+    }
+    static HalfedgeId prev(HalfedgeId h) {
+        return HalfedgeId(h.idx() % 3 == 0 ? h.idx() + 2 : h.idx() - 1);
+    }
+    VertexId origin(HalfedgeId h) const { return VertexId(origin_[h.idx()]); }
+    VertexId target(HalfedgeId h) const { return origin(next(h)); }
+    /// The opposite half-edge, invalid on a boundary.
+    HalfedgeId twin(HalfedgeId h) const { return HalfedgeId(twin_[h.idx()]); }
+    bool is_boundary(HalfedgeId h) const { return twin_[h.idx()] == HalfedgeId::kInvalid; }
+    /// An outgoing half-edge of v; for a boundary vertex the one whose twin is missing.
+    HalfedgeId outgoing(VertexId v) const { return HalfedgeId(outgoing_[v.idx()]); }
+    VertexId vertex(FaceId f, int i) const { return origin(halfedge(f, i)); }
+
+    /// Index of the input facet this face came from (for labels in input order).
+    std::uint32_t source_face(FaceId f) const { return source_face_[f.idx()]; }
+    std::span<const std::uint32_t> source_faces() const { return source_face_; }
+    /// Per-face attributes carried from SRE; empty spans for STL.
+    std::span<const std::int64_t> colors() const { return color_; }
+    std::span<const std::int64_t> cuts() const { return cut_; }
+    std::span<const std::int32_t> surfaces() const { return surface_; }
+    bool has_attributes() const { return !surface_.empty(); }
+
+    /// Unnormalised normal (cross product of two edges): length = twice the area.
+    Vec3 face_normal_area2(FaceId f) const;
+    double face_area(FaceId f) const { return 0.5 * norm(face_normal_area2(f)); }
+    Vec3 face_normal(FaceId f) const { return normalized(face_normal_area2(f)); }
+
+    /// Raw columns (for algorithms that loop over everything).
+    std::span<const std::uint32_t> origins() const { return origin_; }
+    std::span<const std::uint32_t> twins() const { return twin_; }
+
+    /// Checks every invariant (twin symmetry and direction, face/vertex ids in range, the
+    /// outgoing half-edge starts at its vertex and is the boundary one on a boundary, one fan
+    /// per vertex). Returns an empty string when valid, else what is broken. O(n); for tests.
+    std::string validate() const;
+
+   private:
+    friend class MeshBuilder;
+    std::vector<Vec3> position_;
+    std::vector<std::uint32_t> origin_;
+    std::vector<std::uint32_t> twin_;
+    std::vector<std::uint32_t> outgoing_;
+    std::vector<std::uint32_t> source_face_;
+    std::vector<std::int64_t> color_;
+    std::vector<std::int64_t> cut_;
+    std::vector<std::int32_t> surface_;
+};
+
+/// Options of build_mesh(). The defaults need no tuning.
+struct HealOptions {
+    /// Tolerance weld distance in model units. Negative: derived from the model (see
+    /// HealReport::tolerance_rule). Zero: exact weld only.
+    double weld_tolerance = -1.0;
+    /// Orient facets consistently and turn closed components outward.
+    bool orient = true;
+};
+
+/// What healing found and did, in numbers. Counts refer to the input facets / points.
+struct HealReport {
+    double tolerance = 0;        ///< the tolerance weld distance used (model units)
+    std::string tolerance_rule;  ///< how it was chosen, in words
+    std::uint64_t input_facets = 0;
+    std::uint64_t input_points = 0;
+    std::uint64_t exact_welded_points = 0;  ///< points merged with an identical point
+    std::uint64_t welded_vertices = 0;      ///< distinct vertices merged by the tolerance weld
+    std::uint64_t unreferenced_vertices = 0;
+    std::uint64_t degenerate_facets_removed = 0;  ///< repeated vertex or zero area
+    std::uint64_t duplicate_facets_removed = 0;   ///< same three vertices as an earlier facet
+    std::uint64_t flipped_facets = 0;             ///< minority side within each component
+    std::uint64_t components_turned_outward = 0;  ///< closed components that were inside out
+    std::uint64_t nonmanifold_edges = 0;     ///< edges with more than two facets (then split)
+    std::uint64_t nonmanifold_vertices = 0;  ///< vertices with more than one fan (then split)
+    std::uint64_t orientation_conflicts = 0;  ///< edges cut to make a non-orientable part orientable
+};
+
+/// Numbers that describe a built mesh.
+struct MeshStats {
+    std::uint64_t vertices = 0, faces = 0, edges = 0, components = 0;
+    std::uint64_t boundary_loops = 0, boundary_edges = 0;
+    std::int64_t euler_characteristic = 0;
+    bool closed = false;  ///< no boundary edge and at least one face
+    double area = 0;
+    double volume = 0;  ///< signed; meaningful when closed
+    Box3 bbox;
+    std::vector<std::uint32_t> boundary_loop_sizes;  ///< edges per loop, largest first
+};
+
+/// Progress: stage name and fraction done in [0, 1]. Called from the calling thread only.
+using ProgressFn = std::function<void(std::string_view stage, double fraction)>;
+
+struct BuildResult {
+    Mesh mesh;
+    HealReport heal;
+};
+
+/// Builds the half-edge mesh from a soup, healing as ../shared/docs/method.md Step 1 says:
+/// exact weld, tolerance weld, degenerate and duplicate facets dropped, non-manifold edges
+/// and vertices split, facets oriented consistently per component (the minority flipped),
+/// closed components turned outward (positive volume). Deterministic: the same soup gives
+/// the same mesh whatever the thread count. Fails only when the soup cannot be addressed
+/// with 32-bit ids or a triangle names a point that does not exist.
+Result<BuildResult> build_mesh(const TriangleSoup& soup, const HealOptions& options = {},
+                               const ProgressFn& progress = {});
+
+/// Counts, area, volume, bounding box, boundary loops of a mesh.
+MeshStats compute_stats(const Mesh& mesh);
+
+/// The default weld tolerance for points whose bounding box is `box`, and its rule in words.
+double default_weld_tolerance(const Box3& box, std::string* rule = nullptr);
+
+}  // namespace ncrev

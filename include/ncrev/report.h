@@ -1,0 +1,40 @@
+// report: the numbers of every stage, as text for people and JSON for programs.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "ncrev/common.h"
+#include "ncrev/io.h"
+#include "ncrev/mesh.h"
+
+namespace ncrev {
+
+/// What `ncrev info` tells about a file: what was read and what healing did.
+struct InfoReport {
+    std::string path;
+    InputFormat format = InputFormat::kStlBinary;
+    Unit unit = Unit::kMillimetre;
+    bool unit_assumed = true;  ///< STL carries no unit: millimetres are assumed
+    std::uint64_t input_facets = 0;
+    std::uint64_t input_points = 0;
+    std::uint64_t tools = 0, surfaces = 0;  ///< SRE tables
+    HealReport heal;
+    MeshStats mesh;
+    double read_seconds = 0, build_seconds = 0;
+    /// What a user should know (holes, non-manifold parts, flipped facets, ...).
+    std::vector<std::string> warnings;
+};
+
+/// Reads and heals a mesh file and gathers the numbers. Fails with the reader's error.
+Result<InfoReport> inspect_file(const std::filesystem::path& path, const HealOptions& options = {},
+                                const ProgressFn& progress = {});
+
+/// The report as one JSON object (keys: input, healing, mesh, timing, warnings).
+std::string to_json(const InfoReport& report, int indent = 2);
+
+/// The report as a few lines of text for a terminal.
+std::string to_text(const InfoReport& report);
+
+}  // namespace ncrev

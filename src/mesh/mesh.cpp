@@ -1,0 +1,146 @@
+// Mesh queries, invariant checks and statistics.
+#include <algorithm>
+#include <numeric>
+
+#include "ncrev/mesh.h"
+
+namespace ncrev {
+
+Vec3 Mesh::face_normal_area2(FaceId f) const {
+    const Vec3 a = position(vertex(f, 0)), b = position(vertex(f, 1)), c = position(vertex(f, 2));
+    return cross(b - a, c - a);
+}
+
+std::string Mesh::validate() const {
+    const std::size_t nh = num_halfedges(), nv = num_vertices();
+    if (nh % 3 != 0) return "half-edge count is not a multiple of 3";
+    if (twin_.size() != nh) return "twin column size differs from origin column";
+    if (outgoing_.size() != nv) return "outgoing column size differs from vertex count";
+    if (source_face_.size() != num_faces()) return "source-face column size differs from face count";
+    if (!color_.empty() && (color_.size() != num_faces() || cut_.size() != num_faces() ||
+                            surface_.size() != num_faces())) {
+        return "attribute column sizes differ from face count";
+    }
+    auto str = [](std::size_t v) { return std::to_string(v); };
+    std::vector<std::uint32_t> fans(nv, 0);
+    for (std::size_t h = 0; h < nh; ++h) {
+        const HalfedgeId hh(static_cast<std::uint32_t>(h));
+        if (origin_[h] >= nv) return "half-edge " + str(h) + " starts at a vertex out of range";
+        if (origin(hh) == target(hh)) return "half-edge " + str(h) + " is a loop";
+        if (is_boundary(hh)) continue;
+        if (twin_[h] >= nh) return "half-edge " + str(h) + " has a twin out of range";
+        const HalfedgeId t = twin(hh);
+        if (twin(t) != hh) return "twin(twin(" + str(h) + ")) != " + str(h);
+        if (t == hh) return "half-edge " + str(h) + " is its own twin";
+        if (origin(t) != target(hh) || target(t) != origin(hh)) {
+            return "half-edge " + str(h) + " and its twin do not run opposite ways";
+        }
+    }
+    for (std::size_t v = 0; v < nv; ++v) {
+        const std::uint32_t h = outgoing_[v];
+        if (h >= nh) return "vertex " + str(v) + " has no outgoing half-edge";
+        if (origin_[h] != v) return "outgoing half-edge of vertex " + str(v) + " starts elsewhere";
+    }
+    // One fan per vertex: rotating from the outgoing half-edge reaches every half-edge that
+    // starts at the vertex.
+    std::vector<std::uint32_t> reached(nv, 0), total(nv, 0);
+    for (std::size_t h = 0; h < nh; ++h) ++total[origin_[h]];
+    for (std::size_t v = 0; v < nv; ++v) {
+        const HalfedgeId start(outgoing_[v]);
+        HalfedgeId g = start;
+        std::uint32_t count = 0;
+        // A boundary vertex's outgoing half-edge must be the one without twin: then rotating
+        // with twin(prev(g)) walks the whole open fan.
+        bool boundary_vertex = false;
+        for (std::size_t guard = 0; guard <= nh; ++guard) {
+            ++count;
+            const HalfedgeId p = prev(g);
+            if (is_boundary(p)) {
+                boundary_vertex = true;
+                break;
+            }
+            g = twin(p);
+            if (g == start) break;
+        }
+        if (boundary_vertex && !is_boundary(start)) {
+            return "boundary vertex " + str(v) + " has an outgoing half-edge with a twin";
+        }
+        if (count != total[v]) {
+            return "vertex " + str(v) + " has " + str(total[v]) + " outgoing half-edges but its fan holds " +
+                   str(count) + " (non-manifold vertex)";
+        }
+    }
+    return {};
+}
+
+MeshStats compute_stats(const Mesh& mesh) {
+    MeshStats s;
+    const std::size_t nh = mesh.num_halfedges(), nf = mesh.num_faces();
+    s.vertices = mesh.num_vertices();
+    s.faces = nf;
+    for (const Vec3& p : mesh.positions()) s.bbox.add(p);
+    std::uint64_t boundary = 0;
+    for (std::size_t h = 0; h < nh; ++h) boundary += mesh.twins()[h] == HalfedgeId::kInvalid;
+    s.boundary_edges = boundary;
+    s.edges = (nh - boundary) / 2 + boundary;
+    s.euler_characteristic = static_cast<std::int64_t>(s.vertices) -
+                             static_cast<std::int64_t>(s.edges) + static_cast<std::int64_t>(s.faces);
+    s.closed = boundary == 0 && nf > 0;
+
+    // Area and volume, the volume about the box center for precision.
+    const Vec3 c = s.bbox.empty() ? Vec3{} : 0.5 * (s.bbox.min + s.bbox.max);
+    double area = 0, vol6 = 0;
+    for (std::size_t f = 0; f < nf; ++f) {
+        const FaceId ff(static_cast<std::uint32_t>(f));
+        const Vec3 a = mesh.position(mesh.vertex(ff, 0)) - c;
+        const Vec3 b = mesh.position(mesh.vertex(ff, 1)) - c;
+        const Vec3 d = mesh.position(mesh.vertex(ff, 2)) - c;
+        area += 0.5 * norm(cross(b - a, d - a));
+        vol6 += dot(a, cross(b, d));
+    }
+    s.area = area;
+    s.volume = vol6 / 6.0;
+
+    // Components: faces joined across twins.
+    std::vector<std::uint32_t> comp(nf, HalfedgeId::kInvalid);
+    std::vector<std::uint32_t> stack;
+    for (std::size_t seed = 0; seed < nf; ++seed) {
+        if (comp[seed] != HalfedgeId::kInvalid) continue;
+        const auto id = static_cast<std::uint32_t>(s.components++);
+        comp[seed] = id;
+        stack.push_back(static_cast<std::uint32_t>(seed));
+        while (!stack.empty()) {
+            const std::uint32_t f = stack.back();
+            stack.pop_back();
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t t = mesh.twins()[3 * f + k];
+                if (t == HalfedgeId::kInvalid) continue;
+                if (comp[t / 3] == HalfedgeId::kInvalid) {
+                    comp[t / 3] = id;
+                    stack.push_back(t / 3);
+                }
+            }
+        }
+    }
+
+    // Boundary loops: from a boundary half-edge, the next one starts at its target and is
+    // that vertex's outgoing half-edge (the one without twin).
+    std::vector<std::uint8_t> seen(nh, 0);
+    for (std::size_t h = 0; h < nh; ++h) {
+        if (seen[h] || mesh.twins()[h] != HalfedgeId::kInvalid) continue;
+        std::uint32_t len = 0;
+        HalfedgeId g(static_cast<std::uint32_t>(h));
+        for (std::size_t guard = 0; guard <= nh && !seen[g.idx()]; ++guard) {
+            seen[g.idx()] = 1;
+            ++len;
+            g = mesh.outgoing(mesh.target(g));
+            if (!mesh.is_boundary(g)) break;  // cannot happen on a valid mesh
+        }
+        s.boundary_loop_sizes.push_back(len);
+    }
+    std::sort(s.boundary_loop_sizes.begin(), s.boundary_loop_sizes.end(), std::greater<>());
+    s.boundary_loops = s.boundary_loop_sizes.size();
+    return s;
+}
+
+}  // namespace ncrev

@@ -1,0 +1,170 @@
+#include "ncrev/report.h"
+
+#include <chrono>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+namespace ncrev {
+
+namespace {
+
+std::vector<std::string> make_warnings(const InfoReport& r) {
+    std::vector<std::string> w;
+    auto n = [](std::uint64_t v) { return std::to_string(v); };
+    if (r.unit_assumed) w.push_back("STL has no unit: millimetres assumed");
+    if (r.mesh.faces == 0) w.push_back("no facet left after healing");
+    if (r.heal.welded_vertices) {
+        w.push_back(n(r.heal.welded_vertices) + " vertices welded within the tolerance (cracks closed)");
+    }
+    if (r.heal.degenerate_facets_removed) {
+        w.push_back(n(r.heal.degenerate_facets_removed) + " degenerate facets removed");
+    }
+    if (r.heal.duplicate_facets_removed) {
+        w.push_back(n(r.heal.duplicate_facets_removed) + " duplicate facets removed");
+    }
+    if (r.heal.flipped_facets) w.push_back(n(r.heal.flipped_facets) + " facets flipped to agree with their neighbours");
+    if (r.heal.components_turned_outward) {
+        w.push_back(n(r.heal.components_turned_outward) + " inside-out components turned outward");
+    }
+    if (r.heal.nonmanifold_edges) w.push_back(n(r.heal.nonmanifold_edges) + " non-manifold edges split");
+    if (r.heal.nonmanifold_vertices) {
+        w.push_back(n(r.heal.nonmanifold_vertices) + " non-manifold vertices split");
+    }
+    if (r.heal.orientation_conflicts) {
+        w.push_back(n(r.heal.orientation_conflicts) + " edges cut to orient a non-orientable part");
+    }
+    if (r.mesh.faces > 0 && !r.mesh.closed) {
+        w.push_back("mesh is open: " + n(r.mesh.boundary_loops) + " boundary loops, " +
+                    n(r.mesh.boundary_edges) + " boundary edges");
+    }
+    return w;
+}
+
+}  // namespace
+
+Result<InfoReport> inspect_file(const std::filesystem::path& path, const HealOptions& options,
+                                const ProgressFn& progress) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    if (progress) progress("read", 0.0);
+    auto soup = read_mesh_file(path);
+    if (!soup) return soup.error();
+    if (progress) progress("read", 1.0);
+    const auto t1 = Clock::now();
+    auto built = build_mesh(*soup, options, progress);
+    if (!built) {
+        Error e = built.error();
+        e.path = path.string();
+        return e;
+    }
+    const auto t2 = Clock::now();
+    InfoReport r;
+    r.path = path.string();
+    r.format = soup->format;
+    r.unit = soup->unit;
+    r.unit_assumed = soup->format != InputFormat::kSre;
+    r.input_facets = soup->num_facets();
+    r.input_points = soup->points.size();
+    r.tools = soup->tools.size();
+    r.surfaces = soup->surfaces.size();
+    r.heal = built->heal;
+    r.mesh = compute_stats(built->mesh);
+    r.read_seconds = std::chrono::duration<double>(t1 - t0).count();
+    r.build_seconds = std::chrono::duration<double>(t2 - t1).count();
+    r.warnings = make_warnings(r);
+    return r;
+}
+
+std::string to_json(const InfoReport& r, int indent) {
+    using nlohmann::json;
+    auto vec = [](Vec3 v) { return json::array({v.x, v.y, v.z}); };
+    json j;
+    j["input"] = {{"path", r.path},
+                  {"format", to_string(r.format)},
+                  {"facets", r.input_facets},
+                  {"points", r.input_points},
+                  {"unit", to_string(r.unit)},
+                  {"unit_assumed", r.unit_assumed}};
+    if (r.format == InputFormat::kSre) {
+        j["input"]["tools"] = r.tools;
+        j["input"]["surfaces"] = r.surfaces;
+    }
+    const HealReport& h = r.heal;
+    j["healing"] = {{"tolerance", h.tolerance},
+                    {"tolerance_rule", h.tolerance_rule},
+                    {"exact_welded_points", h.exact_welded_points},
+                    {"welded_vertices", h.welded_vertices},
+                    {"unreferenced_vertices", h.unreferenced_vertices},
+                    {"degenerate_facets_removed", h.degenerate_facets_removed},
+                    {"duplicate_facets_removed", h.duplicate_facets_removed},
+                    {"flipped_facets", h.flipped_facets},
+                    {"components_turned_outward", h.components_turned_outward},
+                    {"nonmanifold_edges", h.nonmanifold_edges},
+                    {"nonmanifold_vertices", h.nonmanifold_vertices},
+                    {"orientation_conflicts", h.orientation_conflicts}};
+    const MeshStats& m = r.mesh;
+    json bbox = m.bbox.empty() ? json::array({vec({}), vec({})})
+                               : json::array({vec(m.bbox.min), vec(m.bbox.max)});
+    j["mesh"] = {{"vertices", m.vertices},
+                 {"facets", m.faces},
+                 {"edges", m.edges},
+                 {"components", m.components},
+                 {"boundary_loops", m.boundary_loops},
+                 {"boundary_edges", m.boundary_edges},
+                 {"boundary_loop_sizes", m.boundary_loop_sizes},
+                 {"euler_characteristic", m.euler_characteristic},
+                 {"closed", m.closed},
+                 {"area", m.area},
+                 {"volume", m.volume},
+                 {"bbox", bbox}};
+    j["timing"] = {{"read_seconds", r.read_seconds}, {"build_seconds", r.build_seconds}};
+    j["warnings"] = r.warnings;
+    return j.dump(indent);
+}
+
+std::string to_text(const InfoReport& r) {
+    char buf[512];
+    std::string s;
+    const MeshStats& m = r.mesh;
+    const HealReport& h = r.heal;
+    const char* unit = to_string(r.unit);
+    std::snprintf(buf, sizeof buf, "%s: %s, %llu facets, unit %s%s\n", r.path.c_str(),
+                  to_string(r.format), static_cast<unsigned long long>(r.input_facets), unit,
+                  r.unit_assumed ? " (assumed)" : "");
+    s += buf;
+    std::snprintf(buf, sizeof buf,
+                  "healing: tolerance %.3g %s; %llu welded, %llu degenerate, %llu duplicate, "
+                  "%llu flipped, %llu turned outward, %llu non-manifold edges, %llu non-manifold "
+                  "vertices\n",
+                  h.tolerance, unit, static_cast<unsigned long long>(h.welded_vertices),
+                  static_cast<unsigned long long>(h.degenerate_facets_removed),
+                  static_cast<unsigned long long>(h.duplicate_facets_removed),
+                  static_cast<unsigned long long>(h.flipped_facets),
+                  static_cast<unsigned long long>(h.components_turned_outward),
+                  static_cast<unsigned long long>(h.nonmanifold_edges),
+                  static_cast<unsigned long long>(h.nonmanifold_vertices));
+    s += buf;
+    std::snprintf(buf, sizeof buf,
+                  "mesh: %llu vertices, %llu facets, %llu edges, %llu components, %s "
+                  "(%llu boundary loops, %llu boundary edges), Euler characteristic %lld\n",
+                  static_cast<unsigned long long>(m.vertices),
+                  static_cast<unsigned long long>(m.faces), static_cast<unsigned long long>(m.edges),
+                  static_cast<unsigned long long>(m.components), m.closed ? "closed" : "open",
+                  static_cast<unsigned long long>(m.boundary_loops),
+                  static_cast<unsigned long long>(m.boundary_edges),
+                  static_cast<long long>(m.euler_characteristic));
+    s += buf;
+    if (!m.bbox.empty()) {
+        const Vec3 d = m.bbox.max - m.bbox.min;
+        std::snprintf(buf, sizeof buf,
+                      "geometry: area %.6g %s^2, volume %.6g %s^3, size %.4g x %.4g x %.4g %s\n",
+                      m.area, unit, m.volume, unit, d.x, d.y, d.z, unit);
+        s += buf;
+    }
+    std::snprintf(buf, sizeof buf, "time: read %.3f s, build %.3f s\n", r.read_seconds,
+                  r.build_seconds);
+    s += buf;
+    return s;
+}
+
+}  // namespace ncrev
