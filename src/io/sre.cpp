@@ -187,6 +187,11 @@ class SreParser {
         }
         const std::string_view found = in_.fields()[0];
         if (found == keyword) return Ok{};
+        if (!prev_block_.empty() && looks_like_record_of(prev_block_)) {
+            return error(ErrorCode::kBadCount, "block '" + std::string(prev_block_) +
+                                                   "' holds more records than the " +
+                                                   std::to_string(announced_) + " announced");
+        }
         if (is_block_keyword(found)) {
             return error(ErrorCode::kBadSyntax, "block " + quote(found) +
                                                     " out of order or block '" +
@@ -225,6 +230,7 @@ class SreParser {
         }
         announced_ = count;
         header_line_ = header_line;
+        prev_block_ = keyword;
         const std::size_t plausible =
             std::min<std::size_t>(static_cast<std::size_t>(count), in_.remaining_bytes() / kMinRecordBytes + 1);
         reserve(keyword, plausible, static_cast<std::size_t>(count));
@@ -492,6 +498,7 @@ class SreParser {
     std::string_view name_;
     TriangleSoup soup_;
     std::int64_t announced_ = 0;
+    std::string_view prev_block_;
     std::int64_t header_line_ = 0;
     std::uint64_t surface_count_ = 0;
     std::vector<std::int64_t> surface_seen_line_;

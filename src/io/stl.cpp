@@ -102,13 +102,21 @@ Result<TriangleSoup> read_ascii(std::span<const std::byte> bytes, std::string_vi
         }
         return Ok{};
     };
-    auto number = [&](double& v, bool must_be_finite) -> Status {
+    // Coordinates are float32 in the STL format: the text is rounded to float once, so an
+    // ASCII file and its binary twin give the same mesh.
+    auto number = [&](float& v, bool must_be_finite) -> Status {
         const std::string_view tok = sc.token();
         if (tok.empty()) {
             return make_error(ErrorCode::kTruncated, name, "file ends where a number was expected",
                               sc.line);
         }
-        if (!io_detail::parse_double(tok, v)) {
+        if (!io_detail::parse_float(tok, v)) {
+            // from_chars reports out-of-range values (1e99) as errors: say which.
+            double d;
+            if (io_detail::parse_double(tok, d)) {
+                return make_error(ErrorCode::kBadNumber, name,
+                                  "number " + quote(tok) + " is out of float32 range", sc.line);
+            }
             return make_error(ErrorCode::kBadNumber, name, "expected a number, found " + quote(tok),
                               sc.line);
         }
@@ -149,7 +157,7 @@ Result<TriangleSoup> read_ascii(std::span<const std::byte> bytes, std::string_vi
                               sc.line);
         }
         if (auto s = expect("normal"); !s) return s.error();
-        double ignored;
+        float ignored;
         for (int k = 0; k < 3; ++k) {
             // The stored normal is ignored (vertex order defines orientation); exporters write
             // NaN for degenerate facets, so it need not be finite.
@@ -160,11 +168,11 @@ Result<TriangleSoup> read_ascii(std::span<const std::byte> bytes, std::string_vi
         const auto first = static_cast<std::uint32_t>(soup.points.size());
         for (int k = 0; k < 3; ++k) {
             if (auto s = expect("vertex"); !s) return s.error();
-            Vec3 p;
+            float p[3];
             for (int c = 0; c < 3; ++c) {
                 if (auto s = number(p[c], true); !s) return s.error();
             }
-            soup.points.push_back(p);
+            soup.points.push_back({p[0], p[1], p[2]});
         }
         if (auto s = expect("endloop"); !s) return s.error();
         if (auto s = expect("endfacet"); !s) return s.error();

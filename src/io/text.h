@@ -37,6 +37,19 @@ inline bool parse_double(std::string_view tok, double& out) {
     return ec == std::errc() && ptr == last;
 }
 
+/// Parses a whole token as a float (rounded once, from the decimal text).
+inline bool parse_float(std::string_view tok, float& out) {
+    if (tok.empty()) return false;
+    const char* first = tok.data();
+    const char* last = tok.data() + tok.size();
+    if (*first == '+') {
+        ++first;
+        if (first == last || *first == '+' || *first == '-') return false;
+    }
+    auto [ptr, ec] = std::from_chars(first, last, out, std::chars_format::general);
+    return ec == std::errc() && ptr == last;
+}
+
 /// Parses a whole token as a decimal integer (no exponent, no point).
 inline bool parse_int(std::string_view tok, std::int64_t& out) {
     if (tok.empty()) return false;

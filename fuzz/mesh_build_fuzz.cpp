@@ -1,0 +1,30 @@
+// Fuzz target: mesh building and healing on arbitrary facet soups (coordinates from a small
+// lattice so that welds, duplicates, non-manifold edges and vertices are frequent). The mesh
+// must always satisfy its invariants.
+#include <cstdlib>
+#include <cstring>
+
+#include "ncrev/mesh.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    ncrev::TriangleSoup soup;
+    // Each byte triple is one point on a 4x4x4 lattice plus a tiny jitter (cracks).
+    for (std::size_t i = 0; i + 2 < size; i += 3) {
+        const auto c = [&](std::size_t k) {
+            const std::uint8_t b = data[i + k];
+            return static_cast<double>(b & 3) + ((b >> 2) & 1 ? 1e-9 : 0.0);
+        };
+        soup.points.push_back({c(0), c(1), c(2)});
+    }
+    // Triangles: consecutive points, three at a time (as STL), plus some reuse of earlier ones.
+    for (std::size_t i = 0; i + 2 < soup.points.size(); i += 3) {
+        const auto a = static_cast<std::uint32_t>(i);
+        soup.triangles.push_back({a, a + 1, a + 2});
+    }
+    auto r = ncrev::build_mesh(soup);
+    if (!r.ok()) std::abort();
+    if (!r->mesh.validate().empty()) std::abort();
+    const auto stats = ncrev::compute_stats(r->mesh);
+    if (stats.faces != r->mesh.num_faces()) std::abort();
+    return 0;
+}

@@ -1,0 +1,328 @@
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "ncrev/mesh.h"
+#include "test_meshes.h"
+
+namespace ncrev {
+namespace {
+
+BuildResult build_ok(const TriangleSoup& soup, const HealOptions& opt = {}) {
+    auto r = build_mesh(soup, opt);
+    EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().describe());
+    const std::string broken = r->mesh.validate();
+    EXPECT_EQ(broken, "") << broken;
+    return std::move(r).value();
+}
+
+TEST(MeshBuild, CubeFromFacetBucket) {
+    auto b = build_ok(test::to_bucket(test::cube()));
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_EQ(s.vertices, 8u);
+    EXPECT_EQ(s.faces, 12u);
+    EXPECT_EQ(s.edges, 18u);
+    EXPECT_EQ(s.components, 1u);
+    EXPECT_EQ(s.euler_characteristic, 2);
+    EXPECT_TRUE(s.closed);
+    EXPECT_EQ(s.boundary_loops, 0u);
+    EXPECT_DOUBLE_EQ(s.volume, 1.0);
+    EXPECT_DOUBLE_EQ(s.area, 6.0);
+    EXPECT_EQ(b.heal.exact_welded_points, 36u - 8u);
+    EXPECT_EQ(b.heal.welded_vertices, 0u);
+    EXPECT_EQ(b.heal.flipped_facets, 0u);
+    EXPECT_EQ(b.heal.components_turned_outward, 0u);
+    EXPECT_NEAR(b.heal.tolerance, 1e-6 * std::sqrt(3.0), 1e-12);
+}
+
+TEST(MeshBuild, SphereIsClosedOutwardWithEulerTwo) {
+    auto b = build_ok(test::to_bucket(test::icosphere(10.0, 3)));
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_EQ(s.faces, 1280u);
+    EXPECT_EQ(s.vertices, 642u);
+    EXPECT_EQ(s.euler_characteristic, 2);
+    EXPECT_TRUE(s.closed);
+    EXPECT_EQ(b.heal.components_turned_outward, 0u);
+    EXPECT_GT(s.volume, 0.95 * 4.0 / 3.0 * std::numbers::pi * 1000.0);
+    EXPECT_LT(s.volume, 4.0 / 3.0 * std::numbers::pi * 1000.0);
+}
+
+TEST(MeshBuild, ClosesCracksAtFloatPrecision) {
+    auto soup = test::to_bucket(test::cube({10, 20, 30}, 5.0));
+    // Vertex (15, 25, 35) appears in several facets; nudge two of its copies by 1 and 3 ulps
+    // in different facets, as an exporter that recomputes vertices per facet does.
+    int nudged = 0;
+    for (Vec3& p : soup.points) {
+        if (p == Vec3{15, 25, 35}) {
+            if (nudged == 0) p.x = std::nextafter(static_cast<float>(p.x), 100.f);
+            if (nudged == 2) {
+                float z = static_cast<float>(p.z);
+                for (int i = 0; i < 3; ++i) z = std::nextafter(z, 0.f);
+                p.z = z;
+            }
+            ++nudged;
+        }
+    }
+    ASSERT_GE(nudged, 3);
+    auto exact = build_ok(soup, HealOptions{.weld_tolerance = 0});
+    EXPECT_FALSE(compute_stats(exact.mesh).closed);
+    auto b = build_ok(soup);
+    EXPECT_EQ(b.heal.welded_vertices, 2u);
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_EQ(s.vertices, 8u);
+    EXPECT_TRUE(s.closed);
+    EXPECT_NEAR(s.volume, 125.0, 1e-4);
+}
+
+TEST(MeshBuild, FlipsTheMinorityOfFacets) {
+    auto m = test::icosphere(1.0, 2);
+    for (int f : {3, 50, 51, 200}) std::swap(m.triangles[f][1], m.triangles[f][2]);
+    auto b = build_ok(test::to_bucket(m));
+    EXPECT_EQ(b.heal.flipped_facets, 4u);
+    EXPECT_EQ(b.heal.components_turned_outward, 0u);
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_TRUE(s.closed);
+    EXPECT_GT(s.volume, 0);
+}
+
+TEST(MeshBuild, TurnsInsideOutMeshOutward) {
+    auto m = test::icosphere(1.0, 2);
+    for (auto& t : m.triangles) std::swap(t[1], t[2]);
+    auto b = build_ok(test::to_bucket(m));
+    EXPECT_EQ(b.heal.flipped_facets, 0u);
+    EXPECT_EQ(b.heal.components_turned_outward, 1u);
+    EXPECT_GT(compute_stats(b.mesh).volume, 0);
+}
+
+TEST(MeshBuild, InsideOutWithFewFlippedFacetsCountsBoth) {
+    auto m = test::cube();
+    for (auto& t : m.triangles) std::swap(t[1], t[2]);
+    std::swap(m.triangles[5][1], m.triangles[5][2]);  // back to outward: the minority
+    auto b = build_ok(test::to_bucket(m));
+    EXPECT_EQ(b.heal.flipped_facets, 1u);
+    EXPECT_EQ(b.heal.components_turned_outward, 1u);
+    EXPECT_DOUBLE_EQ(compute_stats(b.mesh).volume, 1.0);
+}
+
+TEST(MeshBuild, RemovesDuplicateFacetsInAnyOrderOrOrientation) {
+    auto m = test::cube();
+    m.triangles.push_back(m.triangles[0]);
+    m.triangles.push_back({m.triangles[4][1], m.triangles[4][2], m.triangles[4][0]});
+    m.triangles.push_back({m.triangles[7][0], m.triangles[7][2], m.triangles[7][1]});
+    auto b = build_ok(test::to_bucket(m));
+    EXPECT_EQ(b.heal.duplicate_facets_removed, 3u);
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_EQ(s.faces, 12u);
+    EXPECT_TRUE(s.closed);
+    // The first of each duplicate pair stays.
+    for (std::size_t f = 0; f < 12; ++f) EXPECT_EQ(b.mesh.source_face(FaceId(f)), f);
+}
+
+TEST(MeshBuild, RemovesDegenerateFacets) {
+    auto m = test::cube();
+    m.points.push_back({0.5, 0, 0});  // on the edge 0-1
+    const auto mid = static_cast<std::uint32_t>(m.points.size() - 1);
+    m.triangles.push_back({0, 0, 3});      // repeated vertex
+    m.triangles.push_back({0, 1, mid});    // zero area: three distinct, collinear vertices
+    m.triangles.push_back({2, 6, 2});      // repeated vertex
+    auto b = build_ok(test::to_bucket(m));
+    EXPECT_EQ(b.heal.degenerate_facets_removed, 3u);
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_EQ(s.faces, 12u);
+    EXPECT_EQ(s.vertices, 8u);  // the collinear point is no longer used
+    EXPECT_TRUE(s.closed);
+}
+
+TEST(MeshBuild, FindsHolesAsBoundaryLoops) {
+    auto m = test::cube();
+    m.triangles.erase(m.triangles.begin() + 2, m.triangles.begin() + 4);  // the top square
+    auto b = build_ok(test::to_bucket(m));
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_FALSE(s.closed);
+    EXPECT_EQ(s.boundary_loops, 1u);
+    EXPECT_EQ(s.boundary_edges, 4u);
+    ASSERT_EQ(s.boundary_loop_sizes.size(), 1u);
+    EXPECT_EQ(s.boundary_loop_sizes[0], 4u);
+    EXPECT_EQ(s.euler_characteristic, 1);  // a disc
+
+    auto m2 = test::cube();
+    m2.triangles.erase(m2.triangles.begin() + 2);  // one top triangle (vertices 4 5 6)
+    m2.triangles.erase(m2.triangles.begin());      // one bottom triangle (0 2 1): no shared vertex
+    auto b2 = build_ok(test::to_bucket(m2));
+    const MeshStats s2 = compute_stats(b2.mesh);
+    EXPECT_EQ(s2.boundary_loops, 2u);
+    EXPECT_EQ(s2.boundary_edges, 6u);
+}
+
+TEST(MeshBuild, SplitsTwoCubesSharingOneEdge) {
+    // Cube B touches cube A only along A's edge x=1, y=1 (z from 0 to 1).
+    auto m = test::merge(test::cube(), test::cube({1, 1, 0}, 1.0));
+    auto soup = test::to_bucket(m);
+    auto b = build_ok(soup);
+    EXPECT_EQ(b.heal.nonmanifold_edges, 1u);
+    EXPECT_EQ(b.heal.nonmanifold_vertices, 2u);
+    EXPECT_EQ(b.heal.flipped_facets, 0u);
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_EQ(s.components, 2u);
+    EXPECT_TRUE(s.closed);
+    EXPECT_EQ(s.vertices, 16u);
+    EXPECT_EQ(s.edges, 36u);
+    EXPECT_EQ(s.euler_characteristic, 4);
+    EXPECT_DOUBLE_EQ(s.volume, 2.0);
+    // Any facet order gives the same split.
+    for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+        auto p = soup;
+        test::permute_facets(p, seed);
+        auto bp = build_ok(p);
+        const MeshStats sp = compute_stats(bp.mesh);
+        EXPECT_EQ(sp.components, 2u) << seed;
+        EXPECT_TRUE(sp.closed) << seed;
+        EXPECT_EQ(bp.heal.nonmanifold_edges, 1u);
+    }
+}
+
+TEST(MeshBuild, CountsTwoDisjointBodies) {
+    auto m = test::merge(test::icosphere(1.0, 2), test::cube({5, 0, 0}, 2.0));
+    auto b = build_ok(test::to_bucket(m));
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_EQ(s.components, 2u);
+    EXPECT_TRUE(s.closed);
+    EXPECT_EQ(s.euler_characteristic, 4);
+    EXPECT_EQ(b.heal.nonmanifold_edges, 0u);
+    EXPECT_EQ(b.heal.nonmanifold_vertices, 0u);
+}
+
+TEST(MeshBuild, TwoCubesSharingOneVertexComeApart) {
+    auto m = test::merge(test::cube(), test::cube({1, 1, 1}, 1.0));
+    auto b = build_ok(test::to_bucket(m));
+    EXPECT_EQ(b.heal.nonmanifold_edges, 0u);
+    EXPECT_EQ(b.heal.nonmanifold_vertices, 1u);
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_EQ(s.components, 2u);
+    EXPECT_EQ(s.vertices, 16u);
+}
+
+TEST(MeshBuild, CutsANonOrientableBand) {
+    auto b = build_ok(test::to_bucket(test::mobius(24)));
+    EXPECT_EQ(b.heal.orientation_conflicts, 1u);
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_FALSE(s.closed);
+    EXPECT_EQ(s.faces, 48u);
+}
+
+TEST(MeshBuild, CarriesAttributesAndSourceIndices) {
+    auto soup = test::to_indexed_soup(test::cube());
+    for (std::size_t f = 0; f < soup.num_facets(); ++f) {
+        soup.color.push_back(static_cast<std::int64_t>(100 + f));
+        soup.cut.push_back(static_cast<std::int64_t>(f % 3) - 1);
+        soup.surface.push_back(static_cast<std::int32_t>(f / 2));
+    }
+    soup.triangles.insert(soup.triangles.begin(), {0, 0, 1});  // degenerate: dropped
+    soup.color.insert(soup.color.begin(), 7);
+    soup.cut.insert(soup.cut.begin(), 7);
+    soup.surface.insert(soup.surface.begin(), 7);
+    auto b = build_ok(soup);
+    ASSERT_TRUE(b.mesh.has_attributes());
+    ASSERT_EQ(b.mesh.num_faces(), 12u);
+    for (std::size_t f = 0; f < 12; ++f) {
+        const std::uint32_t src = b.mesh.source_face(FaceId(f));
+        EXPECT_EQ(src, f + 1);
+        EXPECT_EQ(b.mesh.colors()[f], soup.color[src]);
+        EXPECT_EQ(b.mesh.cuts()[f], soup.cut[src]);
+        EXPECT_EQ(b.mesh.surfaces()[f], soup.surface[src]);
+    }
+}
+
+TEST(MeshBuild, RejectsTriangleNamingMissingPoint) {
+    TriangleSoup soup;
+    soup.points = {{0, 0, 0}, {1, 0, 0}};
+    soup.triangles = {{0, 1, 2}};
+    auto r = build_mesh(soup);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().code, ErrorCode::kIndexOutOfRange);
+}
+
+TEST(MeshBuild, EmptySoupGivesEmptyMesh) {
+    auto b = build_ok(TriangleSoup{});
+    const MeshStats s = compute_stats(b.mesh);
+    EXPECT_EQ(s.faces, 0u);
+    EXPECT_FALSE(s.closed);
+}
+
+void expect_same_stats(const MeshStats& a, const MeshStats& b, double rel) {
+    EXPECT_EQ(a.vertices, b.vertices);
+    EXPECT_EQ(a.faces, b.faces);
+    EXPECT_EQ(a.edges, b.edges);
+    EXPECT_EQ(a.components, b.components);
+    EXPECT_EQ(a.boundary_loops, b.boundary_loops);
+    EXPECT_EQ(a.euler_characteristic, b.euler_characteristic);
+    EXPECT_EQ(a.closed, b.closed);
+    EXPECT_NEAR(a.area, b.area, rel * a.area);
+    EXPECT_NEAR(a.volume, b.volume, rel * std::abs(a.volume));
+}
+
+TEST(MeshBuildInvariance, FacetAndVertexPermutation) {
+    auto m = test::merge(test::icosphere(3.0, 3), test::cube({10, 0, 0}, 2.0));
+    auto base = build_ok(test::to_indexed_soup(m));
+    const MeshStats s0 = compute_stats(base.mesh);
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+        auto soup = test::to_indexed_soup(m);
+        test::permute_facets(soup, seed);
+        test::permute_points(soup, seed + 10);
+        auto b = build_ok(soup);
+        expect_same_stats(s0, compute_stats(b.mesh), 1e-12);
+        auto bucket = test::to_bucket(m);
+        test::permute_facets(bucket, seed);
+        expect_same_stats(s0, compute_stats(build_ok(bucket).mesh), 1e-12);
+    }
+}
+
+TEST(MeshBuildInvariance, RigidMotion) {
+    auto m = test::icosphere(3.0, 3);
+    const MeshStats s0 = compute_stats(build_ok(test::to_bucket(m)).mesh);
+    auto soup = test::to_bucket(m);
+    test::rigid_motion(soup, 0.7, {100, -50, 20});
+    auto b = build_ok(soup);
+    expect_same_stats(s0, compute_stats(b.mesh), 1e-9);
+}
+
+TEST(MeshBuildInvariance, AsciiAndBinaryGiveTheSameMesh) {
+    auto m = test::icosphere(25.0, 3);
+    for (Vec3& p : m.points) p = {0.1 + p.x, p.y / 3.0, p.z * 1.7};  // digits float cannot hold
+    auto bin = read_stl(encode_stl_binary(m.points, m.triangles));
+    auto asc = read_stl(test::bytes_of(encode_stl_ascii(m.points, m.triangles)));
+    ASSERT_TRUE(bin.ok());
+    ASSERT_TRUE(asc.ok()) << asc.error().describe();
+    auto a = build_ok(*bin), c = build_ok(*asc);
+    expect_same_stats(compute_stats(a.mesh), compute_stats(c.mesh), 0.0);
+    EXPECT_EQ(a.mesh.origins().size(), c.mesh.origins().size());
+    EXPECT_TRUE(std::equal(a.mesh.origins().begin(), a.mesh.origins().end(), c.mesh.origins().begin()));
+}
+
+TEST(MeshBuildInvariance, AllFacetsFlippedGivesTheSameSolid) {
+    auto m = test::icosphere(2.0, 2);
+    const MeshStats s0 = compute_stats(build_ok(test::to_bucket(m)).mesh);
+    for (auto& t : m.triangles) std::swap(t[0], t[1]);
+    expect_same_stats(s0, compute_stats(build_ok(test::to_bucket(m)).mesh), 1e-12);
+}
+
+TEST(MeshBuildDeterminism, SameMeshWhateverTheThreadCount) {
+    // Large enough for several parallel chunks (> 32768 points).
+    auto m = test::merge(test::icosphere(5.0, 5), test::merge(test::cube(), test::cube({1, 1, 0})));
+    auto soup = test::to_bucket(m);
+    test::permute_facets(soup, 42);
+    auto run = [&](int threads) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        return build_ok(soup);
+    };
+    const BuildResult one = run(1), many = run(4);
+    EXPECT_TRUE(std::ranges::equal(one.mesh.origins(), many.mesh.origins()));
+    EXPECT_TRUE(std::ranges::equal(one.mesh.twins(), many.mesh.twins()));
+    EXPECT_TRUE(std::ranges::equal(one.mesh.source_faces(), many.mesh.source_faces()));
+    EXPECT_TRUE(std::ranges::equal(one.mesh.positions(), many.mesh.positions()));
+}
+
+}  // namespace
+}  // namespace ncrev
