@@ -160,6 +160,11 @@ struct BuildResult {
 Result<BuildResult> build_mesh(const TriangleSoup& soup, const HealOptions& options = {},
                                const ProgressFn& progress = {});
 
+/// The same, consuming the soup: its points and triangles are reused or freed as soon as they
+/// are no longer needed, which lowers the peak memory by about 80 bytes per facet.
+Result<BuildResult> build_mesh(TriangleSoup&& soup, const HealOptions& options = {},
+                               const ProgressFn& progress = {});
+
 /// Counts, area, volume, bounding box, boundary loops of a mesh.
 MeshStats compute_stats(const Mesh& mesh);
 

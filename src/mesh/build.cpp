@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstring>
 #include <numeric>
@@ -34,10 +35,6 @@ constexpr double kWeldMinUlps = 8;
 // Points per chunk in parallel loops: large enough to amortise scheduling, fixed so that the
 // work split (and so the result) does not depend on the thread count.
 constexpr std::size_t kChunk = 1 << 15;
-// Hash partitions of the exact weld: a power of two well above the core count, so partitions
-// balance, and small enough that each partition's table stays in cache-friendly sizes.
-constexpr int kPartitionBits = 6;
-constexpr std::size_t kPartitions = std::size_t{1} << kPartitionBits;
 
 std::uint64_t bits_of(double v) {
     if (v == 0) v = 0.0;  // -0.0 and 0.0 are the same point
@@ -70,99 +67,84 @@ void for_chunks(std::size_t n, Fn&& fn) {
                       });
 }
 
-/// Exact weld: id[i] = index of point i's class, classes numbered by first occurrence.
-/// Returns the number of classes; rep[k] = first point of class k.
+/// Exact weld: id[i] = class of point i, classes numbered by first occurrence; pos[k] = the
+/// position of class k. Returns the number of classes.
+///
+/// One pass in input order over an open-addressing table of (hash, class) slots. Input order
+/// matters for speed: a vertex recurs in facets written close together, so the comparison
+/// with its first occurrence usually hits the cache. (A hash-partitioned parallel version was
+/// measured 5x slower on 2 cores: it scatters the accesses to the points.)
 std::uint32_t weld_exact(std::span<const Vec3> pts, std::vector<std::uint32_t>& id,
-                         std::vector<std::uint32_t>& rep) {
+                         std::vector<Vec3>& pos) {
     const std::size_t n = pts.size();
-    const std::size_t chunks = (n + kChunk - 1) / kChunk;
-    // 1. Stable counting sort of point indices by hash partition.
-    std::vector<std::uint32_t> counts(chunks * kPartitions, 0);
-    for_chunks(n, [&](std::size_t b, std::size_t e) {
-        std::uint32_t* c = &counts[(b / kChunk) * kPartitions];
-        for (std::size_t i = b; i < e; ++i) ++c[hash_point(pts[i]) >> (64 - kPartitionBits)];
-    });
-    std::vector<std::size_t> part_begin(kPartitions + 1, 0);
-    std::vector<std::size_t> offset(chunks * kPartitions);
-    std::size_t total = 0;
-    for (std::size_t p = 0; p < kPartitions; ++p) {
-        part_begin[p] = total;
-        for (std::size_t c = 0; c < chunks; ++c) {
-            offset[c * kPartitions + p] = total;
-            total += counts[c * kPartitions + p];
+    id.resize(n);
+    pos.clear();
+    // Facet soups hold each vertex about six times: start at a quarter of the points.
+    std::size_t cap = std::bit_ceil(std::max<std::size_t>(1024, n / 4));
+    std::vector<std::uint64_t> table(cap, 0);  // (hash high 32 << 32) | (class + 1); 0 empty
+    // A direct-mapped cache of recent classes, tagged with the hash's high bits so that a
+    // stale entry is rejected without touching the positions: a vertex recurs within a few
+    // rows of facets (a few thousand points later) and is then found without the large table.
+    // 32768 entries x 8 bytes = 256 KiB fits L2 and keeps ~90% of entries alive across 3000
+    // intervening points.
+    constexpr std::size_t kRecent = 1 << 15;
+    // Prefetch distance for the large table (points ahead): hides the miss of a new vertex.
+    constexpr std::size_t kPrefetchAhead = 16;
+    std::vector<std::uint64_t> recent(kRecent, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (i + kPrefetchAhead < n) {
+            __builtin_prefetch(&table[hash_point(pts[i + kPrefetchAhead]) & (cap - 1)]);
         }
-    }
-    part_begin[kPartitions] = total;
-    counts = {};
-    std::vector<std::uint32_t> order(n);
-    for_chunks(n, [&](std::size_t b, std::size_t e) {
-        std::size_t* o = &offset[(b / kChunk) * kPartitions];
-        for (std::size_t i = b; i < e; ++i) {
-            order[o[hash_point(pts[i]) >> (64 - kPartitionBits)]++] = static_cast<std::uint32_t>(i);
-        }
-    });
-    offset = {};
-    // 2. Each partition: an open-addressing table; rep = first index with the same bits.
-    id.assign(n, 0);
-    tbb::parallel_for(std::size_t{0}, kPartitions, [&](std::size_t p) {
-        const std::size_t b = part_begin[p], e = part_begin[p + 1];
-        if (b == e) return;
-        // Slots hold (hash low 32 bits, point index + 1); sized for at most half load, grown
-        // as classes appear, so memory follows the number of distinct points.
-        std::size_t cap = std::bit_ceil(std::max<std::size_t>(64, (e - b) / 2));
-        std::vector<std::uint64_t> table(cap, 0);
-        std::size_t used = 0;
-        auto insert_slot = [&](std::vector<std::uint64_t>& t, std::uint64_t entry) {
-            const std::size_t mask = t.size() - 1;
-            std::size_t s = static_cast<std::uint32_t>(entry >> 32) & mask;
-            while (t[s] != 0) s = (s + 1) & mask;
-            t[s] = entry;
-        };
-        for (std::size_t k = b; k < e; ++k) {
-            const std::uint32_t i = order[k];
-            const auto h32 = static_cast<std::uint32_t>(hash_point(pts[i]));
-            const std::size_t mask = cap - 1;
-            std::size_t s = h32 & mask;
-            std::uint32_t found = kNone;
-            while (table[s] != 0) {
-                const std::uint64_t entry = table[s];
-                if (static_cast<std::uint32_t>(entry >> 32) == h32) {
-                    const auto j = static_cast<std::uint32_t>(entry) - 1;
-                    if (same_point(pts[j], pts[i])) {
-                        found = j;
-                        break;
-                    }
-                }
-                s = (s + 1) & mask;
-            }
-            if (found != kNone) {
-                id[i] = found;
+        const Vec3& q = pts[i];
+        const std::uint64_t h = hash_point(q);
+        const auto h32 = static_cast<std::uint32_t>(h >> 32);
+        std::uint64_t& hint = recent[(h >> 17) & (kRecent - 1)];
+        if (static_cast<std::uint32_t>(hint >> 32) == h32 && hint != 0) {
+            const auto c = static_cast<std::uint32_t>(hint) - 1;
+            if (same_point(pos[c], q)) {
+                id[i] = c;
                 continue;
             }
-            id[i] = i;
-            table[s] = (std::uint64_t{h32} << 32) | (i + 1);
-            if (2 * ++used > cap) {
-                std::vector<std::uint64_t> bigger(2 * cap, 0);
-                for (std::uint64_t entry : table) {
-                    if (entry != 0) insert_slot(bigger, entry);
-                }
-                table.swap(bigger);
-                cap *= 2;
-            }
         }
-    });
-    // 3. Number the classes by first occurrence (id[i] <= i, so one forward pass suffices).
-    std::uint32_t next = 0;
-    rep.clear();
-    for (std::size_t i = 0; i < n; ++i) {
-        if (id[i] == i) {
-            rep.push_back(static_cast<std::uint32_t>(i));
-            id[i] = next++;
-        } else {
-            id[i] = id[id[i]];
+        std::size_t mask = cap - 1;
+        std::size_t s = h & mask;
+        std::uint32_t found = kNone;
+        while (table[s] != 0) {
+            const std::uint64_t entry = table[s];
+            if (static_cast<std::uint32_t>(entry >> 32) == h32) {
+                const auto c = static_cast<std::uint32_t>(entry) - 1;
+                if (same_point(pos[c], q)) {
+                    found = c;
+                    break;
+                }
+            }
+            s = (s + 1) & mask;
+        }
+        if (found != kNone) {
+            id[i] = found;
+            hint = (std::uint64_t{h32} << 32) | (found + 1);
+            continue;
+        }
+        const auto c = static_cast<std::uint32_t>(pos.size());
+        pos.push_back(q);
+        id[i] = c;
+        hint = (std::uint64_t{h32} << 32) | (c + 1);
+        table[s] = (std::uint64_t{h32} << 32) | (c + 1);
+        if (2 * pos.size() > cap) {
+            // Rehash from the positions (the slots keep only 32 bits of the hash).
+            cap *= 2;
+            mask = cap - 1;
+            std::vector<std::uint64_t> bigger(cap, 0);
+            for (std::uint32_t k = 0; k < pos.size(); ++k) {
+                const std::uint64_t hk = hash_point(pos[k]);
+                std::size_t t = hk & mask;
+                while (bigger[t] != 0) t = (t + 1) & mask;
+                bigger[t] = ((hk >> 32) << 32) | (k + 1);
+            }
+            table.swap(bigger);
         }
     }
-    return next;
+    return static_cast<std::uint32_t>(pos.size());
 }
 
 /// Union-find whose root is always the smallest index of its set: the result does not depend
@@ -188,15 +170,15 @@ struct MinUnionFind {
     }
 };
 
-/// Tolerance weld of distinct points: merges every pair closer than `tol` (transitively).
-/// Returns map[u] = the merged class's id (numbered by first occurrence), and the count.
-std::uint32_t weld_tolerance(std::span<const Vec3> pos, double tol, std::vector<std::uint32_t>& map) {
-    const std::size_t n = pos.size();
-    map.resize(n);
-    if (tol <= 0 || n == 0) {
-        std::iota(map.begin(), map.end(), 0u);
-        return static_cast<std::uint32_t>(n);
-    }
+/// Tolerance weld among `cand` (ascending vertex ids): merges every pair closer than `tol`,
+/// transitively. Sets map[v] to the smallest vertex of v's group (identity elsewhere) and
+/// returns the number of vertices merged away.
+std::uint64_t weld_tolerance(std::span<const Vec3> pos, std::span<const std::uint32_t> cand,
+                             double tol, std::vector<std::uint32_t>& map) {
+    map.resize(pos.size());
+    std::iota(map.begin(), map.end(), 0u);
+    const std::size_t n = cand.size();
+    if (tol <= 0 || n < 2) return 0;
     // Cells much larger than tol: a point needs a neighbouring cell only when it lies within
     // tol of that cell's side, which is rare, so most points probe a single cell.
     constexpr double kCellOverTol = 16;
@@ -231,16 +213,16 @@ std::uint32_t weld_tolerance(std::span<const Vec3> pos, double tol, std::vector<
         keys[s] = k;
         return s;
     };
-    // Insert in reverse so that each cell's list is in ascending index order.
+    // Insert in reverse so that each cell's list is in ascending order.
     for (std::size_t i = n; i-- > 0;) {
-        const std::size_t s = slot_of(key_of(pos[i]), true);
+        const std::size_t s = slot_of(key_of(pos[cand[i]]), true);
         next[i] = head[s];
         head[s] = static_cast<std::uint32_t>(i);
     }
     MinUnionFind uf(n);
     const double tol2 = tol * tol;
     for (std::size_t i = 0; i < n; ++i) {
-        const Vec3 p = pos[i];
+        const Vec3 p = pos[cand[i]];
         const Key k = key_of(p);
         int lo[3], hi[3];
         for (int a = 0; a < 3; ++a) {
@@ -255,32 +237,163 @@ std::uint32_t weld_tolerance(std::span<const Vec3> pos, double tol, std::vector<
                     if (s == cap) continue;
                     for (std::uint32_t j = head[s]; j != kNone; j = next[j]) {
                         if (j >= i) break;  // each pair once; lists are ascending
-                        const Vec3 d = pos[j] - p;
+                        const Vec3 d = pos[cand[j]] - p;
                         if (dot(d, d) <= tol2) uf.unite(static_cast<std::uint32_t>(i), j);
                     }
                 }
             }
         }
     }
-    std::uint32_t count = 0;
+    std::uint64_t merged = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const std::uint32_t r = uf.find(static_cast<std::uint32_t>(i));
-        map[i] = (r == i) ? count++ : map[r];
+        if (r != i) {
+            map[cand[i]] = cand[r];
+            ++merged;
+        }
     }
-    return count;
+    return merged;
 }
 
-/// Stable bucket sort of `n` items by key in [0, num_keys): returns offsets (num_keys + 1)
-/// and fills `items` with item indices grouped by key, ascending within a key.
-void bucket_by_key(std::size_t n, std::size_t num_keys,
-                   const std::function<std::uint32_t(std::size_t)>& key,
-                   std::vector<std::uint32_t>& offsets, std::vector<std::uint32_t>& items) {
-    offsets.assign(num_keys + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) ++offsets[key(i) + 1];
-    for (std::size_t k = 0; k < num_keys; ++k) offsets[k + 1] += offsets[k];
-    items.resize(n);
-    std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (std::size_t i = 0; i < n; ++i) items[fill[key(i)]++] = static_cast<std::uint32_t>(i);
+struct PairCounts {
+    std::uint64_t nonmanifold_edges = 0;
+    std::uint64_t unmatched = 0;
+    std::uint64_t duplicates = 0;
+};
+
+/// Pairs the half-edges of the facets whose corners are `c` (facet k: c[3k..3k+2]; half-edge
+/// h runs c[h] -> c[next(h)]). Two half-edges on one edge become mates (whatever their
+/// directions: orientation is fixed later). On an edge with more than two, the facets are
+/// ordered by angle around it and each facet running high -> low is paired with the next one
+/// running low -> high (counter-clockwise about low -> high): those bound one wedge of
+/// material of a consistently oriented solid, so two solids sharing an edge come apart.
+/// Facets with the same three vertices as an earlier one are flagged in `dup`.
+///
+/// Half-edges are bucketed by their lower vertex (a stable counting sort, so each bucket
+/// lists its half-edges in index order); buckets are then independent and processed in
+/// parallel over fixed vertex ranges.
+PairCounts pair_edges(std::span<const std::uint32_t> c, std::span<const Vec3> vpos,
+                      std::vector<std::uint32_t>& mate, std::vector<std::uint8_t>& dup) {
+    const std::size_t nh = c.size();
+    const std::size_t nv = vpos.size();
+    auto nxt = [](std::size_t h) { return h % 3 == 2 ? h - 2 : h + 1; };
+    auto prv = [](std::size_t h) { return h % 3 == 0 ? h + 2 : h - 1; };
+    std::vector<std::uint32_t> start(nv + 1, 0);
+    for (std::size_t f = 0; f < nh; f += 3) {
+        const std::uint32_t a = c[f], b = c[f + 1], d = c[f + 2];
+        ++start[std::min(a, b) + 1];
+        ++start[std::min(b, d) + 1];
+        ++start[std::min(d, a) + 1];
+    }
+    for (std::size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+    struct Item {
+        std::uint32_t other;  // the higher vertex
+        std::uint32_t h;
+    };
+    std::vector<Item> items(nh);
+    {
+        std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+        for (std::size_t h = 0; h < nh; ++h) {
+            const std::uint32_t a = c[h], b = c[nxt(h)];
+            const std::uint32_t lo = std::min(a, b);
+            items[fill[lo]++] = {std::max(a, b), static_cast<std::uint32_t>(h)};
+        }
+    }
+    mate.assign(nh, kNone);
+    dup.assign(nh / 3, 0);
+    constexpr std::size_t kVertexChunk = 1 << 14;
+    const std::size_t chunks = (nv + kVertexChunk - 1) / kVertexChunk;
+    std::vector<PairCounts> counts(chunks);
+    tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
+        PairCounts& pc = counts[chunk];
+        struct Around {
+            double angle;
+            std::uint32_t h;
+            bool forward;  // runs low -> high
+        };
+        std::vector<Around> around;
+        auto flag_dup = [&](std::uint32_t h) {
+            std::atomic_ref<std::uint8_t>(dup[h / 3]).store(1, std::memory_order_relaxed);
+        };
+        const std::size_t v_end = std::min(nv, (chunk + 1) * kVertexChunk);
+        for (std::size_t v = chunk * kVertexChunk; v < v_end; ++v) {
+            Item* bucket = items.data() + start[v];
+            const std::size_t size = start[v + 1] - start[v];
+            // Insertion sort by (other, h): buckets hold a handful of half-edges.
+            for (std::size_t i = 1; i < size; ++i) {
+                const Item x = bucket[i];
+                std::size_t j = i;
+                while (j > 0 && (bucket[j - 1].other > x.other ||
+                                 (bucket[j - 1].other == x.other && bucket[j - 1].h > x.h))) {
+                    bucket[j] = bucket[j - 1];
+                    --j;
+                }
+                bucket[j] = x;
+            }
+            for (std::size_t s = 0; s < size;) {
+                std::size_t t = s + 1;
+                while (t < size && bucket[t].other == bucket[s].other) ++t;
+                const std::size_t k = t - s;
+                if (k == 1) {
+                    ++pc.unmatched;
+                } else if (k == 2) {
+                    const std::uint32_t x = bucket[s].h, y = bucket[s + 1].h;
+                    mate[x] = y;
+                    mate[y] = x;
+                    // Same edge and same opposite vertex: the same three vertices.
+                    if (c[prv(x)] == c[prv(y)]) flag_dup(y);
+                } else {
+                    ++pc.nonmanifold_edges;
+                    for (std::size_t x = s; x < t; ++x) {
+                        for (std::size_t y = s; y < x; ++y) {
+                            if (c[prv(bucket[x].h)] == c[prv(bucket[y].h)]) flag_dup(bucket[x].h);
+                        }
+                    }
+                    const Vec3 p0 = vpos[v];
+                    const Vec3 axis = normalized(vpos[bucket[s].other] - p0);
+                    const Vec3 helper = std::abs(axis.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+                    const Vec3 b1 = normalized(cross(axis, helper));
+                    const Vec3 b2 = cross(axis, b1);
+                    around.clear();
+                    for (std::size_t q = s; q < t; ++q) {
+                        const std::uint32_t h = bucket[q].h;
+                        const Vec3 r = vpos[c[prv(h)]] - p0;
+                        around.push_back({std::atan2(dot(r, b2), dot(r, b1)), h, c[h] == v});
+                    }
+                    std::sort(around.begin(), around.end(), [](const Around& x, const Around& y) {
+                        return x.angle != y.angle ? x.angle < y.angle : x.h < y.h;
+                    });
+                    std::size_t best_offset = 0, best_score = 0;
+                    for (std::size_t off = 0; off < 2; ++off) {
+                        std::size_t score = 0;
+                        for (std::size_t q = 0; q + 1 < k; q += 2) {
+                            score += (!around[(off + q) % k].forward &&
+                                      around[(off + q + 1) % k].forward);
+                        }
+                        if (score > best_score) {
+                            best_score = score;
+                            best_offset = off;
+                        }
+                    }
+                    for (std::size_t q = 0; q + 1 < k; q += 2) {
+                        const std::uint32_t x = around[(best_offset + q) % k].h;
+                        const std::uint32_t y = around[(best_offset + q + 1) % k].h;
+                        mate[x] = y;
+                        mate[y] = x;
+                    }
+                    pc.unmatched += k % 2;
+                }
+                s = t;
+            }
+        }
+    });
+    PairCounts total;
+    for (const PairCounts& pc : counts) {
+        total.nonmanifold_edges += pc.nonmanifold_edges;
+        total.unmatched += pc.unmatched;
+    }
+    for (std::uint8_t d : dup) total.duplicates += d;
+    return total;
 }
 
 }  // namespace
@@ -312,12 +425,14 @@ double default_weld_tolerance(const Box3& box, std::string* rule) {
 /// Friend of Mesh: fills its columns.
 class MeshBuilder {
    public:
-    static Result<BuildResult> build(const TriangleSoup& soup, const HealOptions& options,
-                                     const ProgressFn& progress);
+    /// `owned`: the caller gave its soup away (it is `&soup`): points and triangles are
+    /// reused or released as soon as they are no longer needed, to keep the peak low.
+    static Result<BuildResult> build(const TriangleSoup& soup, TriangleSoup* owned,
+                                     const HealOptions& options, const ProgressFn& progress);
 };
 
-Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, const HealOptions& options,
-                                       const ProgressFn& progress) {
+Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* owned,
+                                       const HealOptions& options, const ProgressFn& progress) {
     auto report_progress = [&](std::string_view stage, double f) {
         if (progress) progress(stage, f);
     };
@@ -348,15 +463,19 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, const HealOptio
     rep.input_facets = num_in;
     rep.input_points = num_points;
 
-    // Bounding box of the points the facets use, and the tolerance.
+    // Bounding box of the input points, and the tolerance.
     Box3 box;
     {
-        std::vector<Box3> boxes((num_in + kChunk - 1) / kChunk);
-        for_chunks(num_in, [&](std::size_t b, std::size_t e) {
-            Box3& bb = boxes[b / kChunk];
-            for (std::size_t f = b; f < e; ++f) {
-                for (std::uint32_t v : soup.triangles[f]) bb.add(soup.points[v]);
+        std::vector<Box3> boxes((num_points + kChunk - 1) / kChunk);
+        for_chunks(num_points, [&](std::size_t b, std::size_t e) {
+            Vec3 lo = soup.points[b], hi = soup.points[b];
+            for (std::size_t i = b; i < e; ++i) {
+                const Vec3 q = soup.points[i];
+                lo = {std::min(lo.x, q.x), std::min(lo.y, q.y), std::min(lo.z, q.z)};
+                hi = {std::max(hi.x, q.x), std::max(hi.y, q.y), std::max(hi.z, q.z)};
             }
+            boxes[b / kChunk].add(lo);
+            boxes[b / kChunk].add(hi);
         });
         for (const Box3& bb : boxes) box.add(bb);
     }
@@ -368,108 +487,127 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, const HealOptio
     }
     const double tol = rep.tolerance;
 
-    // 1. Welds: point -> vertex.
+    // 1. Exact weld: point -> vertex.
     report_progress("weld", 0.0);
     std::vector<std::uint32_t> point_vertex;
-    std::vector<std::uint32_t> class_rep;
-    const std::uint32_t num_exact = weld_exact(soup.points, point_vertex, class_rep);
+    std::vector<Vec3> vpos;
+    const std::uint32_t num_exact = weld_exact(soup.points, point_vertex, vpos);
     rep.exact_welded_points = num_points - num_exact;
-    std::vector<Vec3> vpos(num_exact);
-    for (std::uint32_t k = 0; k < num_exact; ++k) vpos[k] = soup.points[class_rep[k]];
-    class_rep = {};
-    std::vector<std::uint32_t> merge;
-    const std::uint32_t num_merged = weld_tolerance(vpos, tol, merge);
-    rep.welded_vertices = num_exact - num_merged;
-    if (num_merged != num_exact) {
-        // The class keeps the position of its first point (its smallest index).
-        std::vector<Vec3> merged(num_merged);
-        for (std::size_t u = num_exact; u-- > 0;) merged[merge[u]] = vpos[u];
-        vpos.swap(merged);
-        for_chunks(num_points, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) point_vertex[i] = merge[point_vertex[i]];
-        });
-    }
-    merge = {};
-    report_progress("weld", 1.0);
+    if (owned) owned->points = {};  // from here on only vpos is read
 
-    // 2. Degenerate facets: a repeated vertex, or a height below the weld tolerance.
-    report_progress("clean", 0.0);
-    std::vector<std::array<std::uint32_t, 3>> tri(num_in);
-    std::vector<std::uint8_t> degenerate(num_in, 0);
+    // Welded corners; in place of the input triangles when the soup is ours.
+    std::vector<std::array<std::uint32_t, 3>> tri;
+    if (owned) {
+        tri = std::move(owned->triangles);
+    } else {
+        tri.resize(num_in);
+    }
+    const auto& input_tri = owned ? tri : soup.triangles;
     for_chunks(num_in, [&](std::size_t b, std::size_t e) {
         for (std::size_t f = b; f < e; ++f) {
-            const auto& t = soup.triangles[f];
-            const std::array<std::uint32_t, 3> c = {point_vertex[t[0]], point_vertex[t[1]],
-                                                    point_vertex[t[2]]};
-            tri[f] = c;
-            if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
-                degenerate[f] = 1;
-                continue;
-            }
-            const Vec3 a = vpos[c[0]], bb = vpos[c[1]], cc = vpos[c[2]];
-            const double area2 = norm(cross(bb - a, cc - a));
-            const double longest =
-                std::sqrt(std::max({dot(bb - a, bb - a), dot(cc - bb, cc - bb), dot(a - cc, a - cc)}));
-            // twice the area / longest edge = the smallest height of the triangle
-            if (area2 <= tol * longest) degenerate[f] = 2;
+            const auto& t = input_tri[f];
+            tri[f] = {point_vertex[t[0]], point_vertex[t[1]], point_vertex[t[2]]};
         }
     });
     point_vertex = {};
-    std::vector<std::uint32_t> kept;  // input facet index of each kept facet
-    kept.reserve(num_in);
-    for (std::size_t f = 0; f < num_in; ++f) {
-        if (degenerate[f]) {
-            ++rep.degenerate_facets_removed;
-        } else {
-            kept.push_back(static_cast<std::uint32_t>(f));
-        }
-    }
-    degenerate = {};
+    report_progress("weld", 1.0);
 
-    // 3. Duplicate facets: same three vertices (in any order) as an earlier facet.
-    {
-        std::vector<std::uint32_t> offsets, items;
-        auto min_vertex = [&](std::size_t k) {
-            const auto& t = tri[kept[k]];
-            return std::min({t[0], t[1], t[2]});
-        };
-        bucket_by_key(kept.size(), vpos.size(), min_vertex, offsets, items);
-        std::vector<std::uint8_t> dup(kept.size(), 0);
-        std::vector<std::pair<std::uint64_t, std::uint32_t>> local;
-        for (std::size_t v = 0; v + 1 < offsets.size(); ++v) {
-            const std::uint32_t b = offsets[v], e = offsets[v + 1];
-            if (e - b < 2) continue;
-            local.clear();
-            for (std::uint32_t k = b; k < e; ++k) {
-                auto t = tri[kept[items[k]]];
-                std::sort(t.begin(), t.end());
-                local.emplace_back((std::uint64_t{t[1]} << 32) | t[2], items[k]);
+    // 2. Degenerate facets: a repeated vertex, or a height below the weld tolerance.
+    report_progress("pair", 0.0);
+    std::vector<std::uint32_t> kept(num_in);  // input facet index of each kept facet
+    std::iota(kept.begin(), kept.end(), 0u);
+    auto drop_degenerate = [&]() {
+        std::vector<std::uint8_t> bad(kept.size(), 0);
+        for_chunks(kept.size(), [&](std::size_t b, std::size_t e) {
+            for (std::size_t k = b; k < e; ++k) {
+                const auto& t = tri[kept[k]];
+                if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+                    bad[k] = 1;
+                    continue;
+                }
+                const Vec3 p0 = vpos[t[0]], p1 = vpos[t[1]], p2 = vpos[t[2]];
+                const double area2 = norm(cross(p1 - p0, p2 - p0));
+                const double longest = std::sqrt(
+                    std::max({dot(p1 - p0, p1 - p0), dot(p2 - p1, p2 - p1), dot(p0 - p2, p0 - p2)}));
+                // twice the area / longest edge = the smallest height of the triangle
+                if (area2 <= tol * longest) bad[k] = 1;
             }
-            std::sort(local.begin(), local.end());
-            for (std::size_t k = 1; k < local.size(); ++k) {
-                if (local[k].first == local[k - 1].first) dup[local[k].second] = 1;
-            }
-        }
+        });
         std::size_t w = 0;
         for (std::size_t k = 0; k < kept.size(); ++k) {
-            if (dup[k]) {
-                ++rep.duplicate_facets_removed;
+            if (bad[k]) {
+                ++rep.degenerate_facets_removed;
             } else {
                 kept[w++] = kept[k];
             }
         }
         kept.resize(w);
+    };
+    drop_degenerate();
+
+    // 3. Pair half-edges into edges, dropping duplicate facets (same three vertices as an
+    // earlier facet) and, once, welding within the tolerance the vertices of unmatched edges:
+    // a crack always leaves unmatched edges at its vertices, while a vertex whose edges all
+    // match is sound and is never moved.
+    std::vector<std::uint32_t> corner;  // kept facet k: corner[3k .. 3k+2]
+    std::vector<std::uint32_t> mate;
+    std::vector<std::uint8_t> dup;
+    bool tolerance_done = false;
+    for (;;) {
+        corner.resize(3 * kept.size());
+        for_chunks(kept.size(), [&](std::size_t b, std::size_t e) {
+            for (std::size_t k = b; k < e; ++k) {
+                const auto& t = tri[kept[k]];
+                corner[3 * k] = t[0];
+                corner[3 * k + 1] = t[1];
+                corner[3 * k + 2] = t[2];
+            }
+        });
+        const PairCounts pc = pair_edges(corner, vpos, mate, dup);
+        if (pc.duplicates > 0) {
+            std::size_t w = 0;
+            for (std::size_t k = 0; k < kept.size(); ++k) {
+                if (dup[k]) {
+                    ++rep.duplicate_facets_removed;
+                } else {
+                    kept[w++] = kept[k];
+                }
+            }
+            kept.resize(w);
+            continue;
+        }
+        if (!tolerance_done && tol > 0 && pc.unmatched > 0) {
+            tolerance_done = true;
+            std::vector<std::uint32_t> cand;
+            for (std::size_t h = 0; h < corner.size(); ++h) {
+                if (mate[h] == kNone) {
+                    cand.push_back(corner[h]);
+                    cand.push_back(corner[h % 3 == 2 ? h - 2 : h + 1]);
+                }
+            }
+            std::sort(cand.begin(), cand.end());
+            cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+            std::vector<std::uint32_t> map;
+            rep.welded_vertices = weld_tolerance(vpos, cand, tol, map);
+            if (rep.welded_vertices > 0) {
+                for (std::uint32_t f : kept) {
+                    for (std::uint32_t& v : tri[f]) v = map[v];
+                }
+                drop_degenerate();
+                continue;
+            }
+        }
+        rep.nonmanifold_edges = pc.nonmanifold_edges;
+        break;
     }
+    dup = {};
     const std::size_t nf = kept.size();
     const std::size_t nh = 3 * nf;
 
     // 4. Compact the vertices to those the kept facets use (in vertex order).
-    std::vector<std::uint32_t> corner(nh);
     {
         std::vector<std::uint32_t> remap(vpos.size(), kNone);
-        for (std::size_t f = 0; f < nf; ++f) {
-            for (std::uint32_t v : tri[kept[f]]) remap[v] = 0;
-        }
+        for (std::uint32_t v : corner) remap[v] = 0;
         std::uint32_t nv = 0;
         for (std::size_t v = 0; v < vpos.size(); ++v) {
             if (remap[v] != kNone) {
@@ -479,93 +617,12 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, const HealOptio
         }
         rep.unreferenced_vertices = vpos.size() - nv;
         vpos.resize(nv);
-        vpos.shrink_to_fit();
-        for (std::size_t f = 0; f < nf; ++f) {
-            const auto& t = tri[kept[f]];
-            for (int k = 0; k < 3; ++k) corner[3 * f + k] = remap[t[k]];
-        }
+        for_chunks(nh, [&](std::size_t b, std::size_t e) {
+            for (std::size_t h = b; h < e; ++h) corner[h] = remap[corner[h]];
+        });
     }
     tri = {};
     const std::size_t nv = vpos.size();
-    report_progress("clean", 1.0);
-
-    // 5. Pair half-edges into edges. Half-edge h runs corner[h] -> corner[next(h)].
-    report_progress("pair", 0.0);
-    auto hnext = [](std::size_t h) { return h % 3 == 2 ? h - 2 : h + 1; };
-    std::vector<std::uint32_t> mate(nh, kNone);
-    {
-        std::vector<std::uint32_t> offsets, items;
-        auto low = [&](std::size_t h) { return std::min(corner[h], corner[hnext(h)]); };
-        bucket_by_key(nh, nv, low, offsets, items);
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> local;  // (high vertex, half-edge)
-        struct Around {
-            double angle;
-            std::uint32_t h;
-            bool forward;  // runs low -> high
-        };
-        std::vector<Around> around;
-        for (std::size_t v = 0; v < nv; ++v) {
-            const std::uint32_t b = offsets[v], e = offsets[v + 1];
-            local.clear();
-            for (std::uint32_t k = b; k < e; ++k) {
-                const std::uint32_t h = items[k];
-                local.emplace_back(std::max(corner[h], corner[hnext(h)]), h);
-            }
-            std::sort(local.begin(), local.end());
-            for (std::size_t s = 0; s < local.size();) {
-                std::size_t t = s + 1;
-                while (t < local.size() && local[t].first == local[s].first) ++t;
-                const std::size_t k = t - s;
-                if (k == 2) {
-                    mate[local[s].second] = local[s + 1].second;
-                    mate[local[s + 1].second] = local[s].second;
-                } else if (k > 2) {
-                    // Non-manifold edge: order its facets by angle around the edge and pair
-                    // each facet running high -> low with the next one running low -> high
-                    // (counter-clockwise about low -> high): those bound one wedge of
-                    // material of a consistently oriented solid, so two solids sharing an
-                    // edge come apart.
-                    ++rep.nonmanifold_edges;
-                    const Vec3 p0 = vpos[v];
-                    const Vec3 axis = normalized(vpos[local[s].first] - p0);
-                    const Vec3 helper = std::abs(axis.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-                    const Vec3 b1 = normalized(cross(axis, helper));
-                    const Vec3 b2 = cross(axis, b1);
-                    around.clear();
-                    for (std::size_t q = s; q < t; ++q) {
-                        const std::uint32_t h = local[q].second;
-                        const std::uint32_t third = corner[hnext(hnext(h))];
-                        const Vec3 r = vpos[third] - p0;
-                        around.push_back({std::atan2(dot(r, b2), dot(r, b1)), h, corner[h] == v});
-                    }
-                    std::sort(around.begin(), around.end(), [](const Around& x, const Around& y) {
-                        return x.angle != y.angle ? x.angle < y.angle : x.h < y.h;
-                    });
-                    std::size_t best_offset = 0;
-                    std::size_t best_score = 0;
-                    for (std::size_t off = 0; off < 2 && off < k; ++off) {
-                        std::size_t score = 0;
-                        for (std::size_t q = 0; q + 1 < k; q += 2) {
-                            const Around& x = around[(off + q) % k];
-                            const Around& y = around[(off + q + 1) % k];
-                            score += (!x.forward && y.forward) ? 1 : 0;
-                        }
-                        if (score > best_score) {
-                            best_score = score;
-                            best_offset = off;
-                        }
-                    }
-                    for (std::size_t q = 0; q + 1 < k; q += 2) {
-                        const std::uint32_t x = around[(best_offset + q) % k].h;
-                        const std::uint32_t y = around[(best_offset + q + 1) % k].h;
-                        mate[x] = y;
-                        mate[y] = x;
-                    }
-                }
-                s = t;
-            }
-        }
-    }
     report_progress("pair", 1.0);
 
     // 6. Orientation: breadth-first over each component in facet order; a neighbour across
@@ -760,7 +817,13 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, const HealOptio
 
 Result<BuildResult> build_mesh(const TriangleSoup& soup, const HealOptions& options,
                                const ProgressFn& progress) {
-    return MeshBuilder::build(soup, options, progress);
+    return MeshBuilder::build(soup, nullptr, options, progress);
+}
+
+Result<BuildResult> build_mesh(TriangleSoup&& soup, const HealOptions& options,
+                               const ProgressFn& progress) {
+    TriangleSoup owned = std::move(soup);
+    return MeshBuilder::build(owned, &owned, options, progress);
 }
 
 }  // namespace ncrev

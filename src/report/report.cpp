@@ -51,13 +51,6 @@ Result<InfoReport> inspect_file(const std::filesystem::path& path, const HealOpt
     if (!soup) return soup.error();
     if (progress) progress("read", 1.0);
     const auto t1 = Clock::now();
-    auto built = build_mesh(*soup, options, progress);
-    if (!built) {
-        Error e = built.error();
-        e.path = path.string();
-        return e;
-    }
-    const auto t2 = Clock::now();
     InfoReport r;
     r.path = path.string();
     r.format = soup->format;
@@ -67,6 +60,13 @@ Result<InfoReport> inspect_file(const std::filesystem::path& path, const HealOpt
     r.input_points = soup->points.size();
     r.tools = soup->tools.size();
     r.surfaces = soup->surfaces.size();
+    auto built = build_mesh(std::move(soup).value(), options, progress);
+    if (!built) {
+        Error e = built.error();
+        e.path = path.string();
+        return e;
+    }
+    const auto t2 = Clock::now();
     r.heal = built->heal;
     r.mesh = compute_stats(built->mesh);
     r.read_seconds = std::chrono::duration<double>(t1 - t0).count();

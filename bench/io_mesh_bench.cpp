@@ -1,0 +1,109 @@
+// Readers and mesh building: throughput (facets/s, bytes/s) and peak heap per facet.
+// Peers (OpenMesh, CGAL) are in peer_*_bench.cpp, built when installed.
+#include <tbb/global_control.h>
+
+#include "bench_common.h"
+#include "ncrev/mesh.h"
+
+namespace ncrev::bench {
+namespace {
+
+constexpr std::size_t k100k = 100'000, k1M = 1'000'000, k5M = 5'000'000;
+
+std::span<const std::byte> as_bytes(const std::string& s) {
+    return {reinterpret_cast<const std::byte*>(s.data()), s.size()};
+}
+
+void BM_ReadStlBinary(benchmark::State& state) {
+    const auto n = static_cast<std::size_t>(state.range(0));
+    const auto& bytes = stl_binary_bytes(n);
+    std::size_t facets = 0;
+    for (auto _ : state) {
+        auto soup = read_stl(bytes);
+        if (!soup) state.SkipWithError("read failed");
+        facets = soup->num_facets();
+        benchmark::DoNotOptimize(soup->points.data());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * facets));
+    state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * bytes.size()));
+    state.counters["facets"] = static_cast<double>(facets);
+}
+BENCHMARK(BM_ReadStlBinary)->Arg(k100k)->Arg(k1M)->Arg(k5M)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_ReadStlAscii(benchmark::State& state) {
+    const auto n = static_cast<std::size_t>(state.range(0));
+    const auto& text = stl_ascii_text(n);
+    std::size_t facets = 0;
+    for (auto _ : state) {
+        auto soup = read_stl(as_bytes(text));
+        if (!soup) state.SkipWithError("read failed");
+        facets = soup->num_facets();
+        benchmark::DoNotOptimize(soup->points.data());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * facets));
+    state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * text.size()));
+}
+BENCHMARK(BM_ReadStlAscii)->Arg(k100k)->Arg(k1M)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_ReadSre(benchmark::State& state) {
+    const auto n = static_cast<std::size_t>(state.range(0));
+    const auto& text = sre_text(n);
+    std::size_t facets = 0;
+    for (auto _ : state) {
+        auto soup = read_sre(as_bytes(text));
+        if (!soup) state.SkipWithError("read failed");
+        facets = soup->num_facets();
+        benchmark::DoNotOptimize(soup->points.data());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * facets));
+    state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * text.size()));
+}
+BENCHMARK(BM_ReadSre)->Arg(k100k)->Arg(k1M)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Weld + half-edge build + orientation from a soup already in memory (the soup is not
+// consumed, so that iterations repeat the same work). Second argument: threads.
+void BM_BuildMesh(benchmark::State& state) {
+    const auto n = static_cast<std::size_t>(state.range(0));
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                                static_cast<std::size_t>(state.range(1)));
+    const auto& soup = torus_soup(n);
+    for (auto _ : state) {
+        auto built = build_mesh(soup);
+        if (!built) state.SkipWithError("build failed");
+        benchmark::DoNotOptimize(built->mesh.twins().data());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * soup.num_facets()));
+}
+BENCHMARK(BM_BuildMesh)
+    ->Args({k100k, 1})->Args({k100k, 2})
+    ->Args({k1M, 1})->Args({k1M, 2})
+    ->Args({k5M, 2})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// What `ncrev info` does: read a binary STL file from the page cache and build the mesh,
+// consuming the soup. Reports the peak heap above the start, per facet.
+void BM_ReadAndBuildFile(benchmark::State& state) {
+    const auto n = static_cast<std::size_t>(state.range(0));
+    const auto path = stl_binary_file(n);
+    std::size_t facets = 0;
+    double peak_per_facet = 0;
+    for (auto _ : state) {
+        const std::size_t base = heap_now();
+        heap_reset_peak();
+        auto soup = read_mesh_file(path);
+        if (!soup) state.SkipWithError("read failed");
+        facets = soup->num_facets();
+        auto built = build_mesh(std::move(soup).value());
+        if (!built) state.SkipWithError("build failed");
+        benchmark::DoNotOptimize(built->mesh.twins().data());
+        peak_per_facet = static_cast<double>(heap_peak() - base) / static_cast<double>(facets);
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * facets));
+    state.counters["peak_heap_B_per_facet"] = peak_per_facet;
+}
+BENCHMARK(BM_ReadAndBuildFile)->Arg(k100k)->Arg(k1M)->Arg(k5M)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace ncrev::bench
+
+BENCHMARK_MAIN();
