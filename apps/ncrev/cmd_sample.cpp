@@ -44,8 +44,7 @@ void print_list(bool json) {
     std::size_t width = 0;
     for (const SamplePartInfo& p : sample_parts()) width = std::max(width, p.name.size());
     for (const SamplePartInfo& p : sample_parts()) {
-        std::cout << p.name << std::string(width + 2 - p.name.size(), ' ') << p.description
-                  << '\n';
+        std::cout << p.name << std::string(width + 2 - p.name.size(), ' ') << p.description << '\n';
     }
 }
 
@@ -84,8 +83,8 @@ int run_sample(const SampleCliOptions& o) {
         Result<SamplePart> part = make_sample_part(name, options);
         if (!part) {
             print_error(part.error().describe());
-            exit_code = part.error().code == ErrorCode::kCannotWrite ? kExitCannotWrite
-                                                                     : kExitNoResult;
+            exit_code =
+                part.error().code == ErrorCode::kCannotWrite ? kExitCannotWrite : kExitNoResult;
             if (exit_code == kExitCannotWrite) break;
             continue;
         }
@@ -98,8 +97,7 @@ int run_sample(const SampleCliOptions& o) {
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         if (part->weld.float32_mismatches != 0 && !o.quiet) {
-            print_warning(std::string(name) + ": " +
-                          std::to_string(part->weld.float32_mismatches) +
+            print_warning(std::string(name) + ": " + std::to_string(part->weld.float32_mismatches) +
                           " shared mesh nodes differ in float32 between faces (merged anyway)");
         }
         if (o.json) {
