@@ -28,7 +28,12 @@ void BM_ReadStlBinary(benchmark::State& state) {
     state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * bytes.size()));
     state.counters["facets"] = static_cast<double>(facets);
 }
-BENCHMARK(BM_ReadStlBinary)->Arg(k100k)->Arg(k1M)->Arg(k5M)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ReadStlBinary)
+    ->Arg(k100k)
+    ->Arg(k1M)
+    ->Arg(k5M)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_ReadStlAscii(benchmark::State& state) {
     const auto n = static_cast<std::size_t>(state.range(0));
@@ -75,10 +80,13 @@ void BM_BuildMesh(benchmark::State& state) {
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * soup.num_facets()));
 }
 BENCHMARK(BM_BuildMesh)
-    ->Args({k100k, 1})->Args({k100k, 2})
-    ->Args({k1M, 1})->Args({k1M, 2})
+    ->Args({k100k, 1})
+    ->Args({k100k, 2})
+    ->Args({k1M, 1})
+    ->Args({k1M, 2})
     ->Args({k5M, 2})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // What `ncrev info` does: read a binary STL file from the page cache and build the mesh,
 // consuming the soup. Reports the peak heap above the start, per facet.
@@ -101,7 +109,12 @@ void BM_ReadAndBuildFile(benchmark::State& state) {
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * facets));
     state.counters["peak_heap_B_per_facet"] = peak_per_facet;
 }
-BENCHMARK(BM_ReadAndBuildFile)->Arg(k100k)->Arg(k1M)->Arg(k5M)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ReadAndBuildFile)
+    ->Arg(k100k)
+    ->Arg(k1M)
+    ->Arg(k5M)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace ncrev::bench

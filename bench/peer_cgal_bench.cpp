@@ -37,7 +37,13 @@ void BM_Peer_Cgal_SoupToMesh(benchmark::State& state) {
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * soup.num_facets()));
 }
-BENCHMARK(BM_Peer_Cgal_SoupToMesh)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1)->Repetitions(3);
+BENCHMARK(BM_Peer_Cgal_SoupToMesh)
+    ->Arg(100'000)
+    ->Arg(1'000'000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1)
+    ->Repetitions(3);
 
 }  // namespace
 }  // namespace ncrev::bench

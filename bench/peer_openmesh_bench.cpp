@@ -30,7 +30,11 @@ void BM_Peer_OpenMesh_ReadStlFile(benchmark::State& state) {
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * facets));
     state.counters["peak_heap_B_per_facet"] = peak_per_facet;
 }
-BENCHMARK(BM_Peer_OpenMesh_ReadStlFile)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Peer_OpenMesh_ReadStlFile)
+    ->Arg(100'000)
+    ->Arg(1'000'000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_Peer_OpenMesh_Build(benchmark::State& state) {
     const auto n = static_cast<std::size_t>(state.range(0));
@@ -44,7 +48,8 @@ void BM_Peer_OpenMesh_Build(benchmark::State& state) {
             std::array<int, 3> tri{};
             for (int k = 0; k < 3; ++k) {
                 const Vec3 p = soup.points[t[k]];
-                auto [it, fresh] = ids.emplace(std::make_tuple(p.x, p.y, p.z), static_cast<int>(pts.size()));
+                auto [it, fresh] =
+                    ids.emplace(std::make_tuple(p.x, p.y, p.z), static_cast<int>(pts.size()));
                 if (fresh) pts.push_back(p);
                 tri[k] = it->second;
             }
@@ -57,15 +62,19 @@ void BM_Peer_OpenMesh_Build(benchmark::State& state) {
         std::vector<OmMesh::VertexHandle> vh;
         vh.reserve(pts.size());
         for (const Vec3& p : pts) {
-            vh.push_back(mesh.add_vertex(OmMesh::Point(static_cast<float>(p.x), static_cast<float>(p.y),
-                                                       static_cast<float>(p.z))));
+            vh.push_back(mesh.add_vertex(OmMesh::Point(
+                static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z))));
         }
         for (const auto& t : tris) mesh.add_face(vh[t[0]], vh[t[1]], vh[t[2]]);
         benchmark::DoNotOptimize(mesh.n_faces());
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * tris.size()));
 }
-BENCHMARK(BM_Peer_OpenMesh_Build)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Peer_OpenMesh_Build)
+    ->Arg(100'000)
+    ->Arg(1'000'000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace ncrev::bench

@@ -18,7 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             if (v >= s.points.size()) std::abort();
         }
         if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) std::abort();
-        if (s.surface[f] < -1 || s.surface[f] >= static_cast<std::int64_t>(s.surfaces.size())) std::abort();
+        if (s.surface[f] < -1 || s.surface[f] >= static_cast<std::int64_t>(s.surfaces.size()))
+            std::abort();
     }
     // What was accepted must round-trip through the writer.
     const std::string text = ncrev::encode_sre(s);

@@ -7,7 +7,7 @@ set -euo pipefail
 
 packages=(
     build-essential cmake ninja-build pkg-config git
-    g++ clang-14 libclang-rt-14-dev            # clang for the sanitizer build and libFuzzer
+    g++ clang-14 libclang-rt-14-dev clang-format  # clang: sanitizer build, libFuzzer; format check
     libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev
     libocct-data-exchange-dev libocct-ocaf-dev libocct-visualization-dev
     libeigen3-dev libtbb-dev libcli11-dev nlohmann-json3-dev

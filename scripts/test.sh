@@ -12,6 +12,9 @@ if [[ "${NCREV_SKIP_INSTALL:-0}" != "1" ]]; then
     bash scripts/install-deps.sh
 fi
 
+echo "== format (.clang-format)"
+git ls-files '*.cpp' '*.h' | xargs clang-format --dry-run --Werror
+
 echo "== build (Release, warnings as errors)"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DNCREV_WERROR=ON >/dev/null
 cmake --build build -j"$jobs"
@@ -45,7 +48,8 @@ if [[ "${NCREV_SKIP_SANITIZERS:-0}" != "1" ]]; then
     cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNCREV_SANITIZE=ON \
         -DNCREV_WERROR=ON -DNCREV_BUILD_BENCH=OFF -DCMAKE_CXX_COMPILER=clang++-14 >/dev/null
     cmake --build build-asan -j"$jobs"
-    ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+    ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions="$PWD/tests/lsan.supp" \
+        UBSAN_OPTIONS=print_stacktrace=1 \
         ctest --test-dir build-asan --output-on-failure -j"$jobs"
 fi
 echo "== all checks passed"

@@ -4,21 +4,36 @@ namespace ncrev {
 
 const char* to_string(ErrorCode code) {
     switch (code) {
-        case ErrorCode::kCannotOpen: return "cannot-open";
-        case ErrorCode::kCannotWrite: return "cannot-write";
-        case ErrorCode::kEmpty: return "empty";
-        case ErrorCode::kUnknownFormat: return "unknown-format";
-        case ErrorCode::kTruncated: return "truncated";
-        case ErrorCode::kSizeMismatch: return "size-mismatch";
-        case ErrorCode::kBadNumber: return "bad-number";
-        case ErrorCode::kBadSyntax: return "bad-syntax";
-        case ErrorCode::kBadCount: return "bad-count";
-        case ErrorCode::kBadValue: return "bad-value";
-        case ErrorCode::kIndexOutOfRange: return "index-out-of-range";
-        case ErrorCode::kDuplicateIndex: return "duplicate-index";
-        case ErrorCode::kMissingIndex: return "missing-index";
-        case ErrorCode::kTrailingContent: return "trailing-content";
-        case ErrorCode::kTooLarge: return "too-large";
+        case ErrorCode::kCannotOpen:
+            return "cannot-open";
+        case ErrorCode::kCannotWrite:
+            return "cannot-write";
+        case ErrorCode::kEmpty:
+            return "empty";
+        case ErrorCode::kUnknownFormat:
+            return "unknown-format";
+        case ErrorCode::kTruncated:
+            return "truncated";
+        case ErrorCode::kSizeMismatch:
+            return "size-mismatch";
+        case ErrorCode::kBadNumber:
+            return "bad-number";
+        case ErrorCode::kBadSyntax:
+            return "bad-syntax";
+        case ErrorCode::kBadCount:
+            return "bad-count";
+        case ErrorCode::kBadValue:
+            return "bad-value";
+        case ErrorCode::kIndexOutOfRange:
+            return "index-out-of-range";
+        case ErrorCode::kDuplicateIndex:
+            return "duplicate-index";
+        case ErrorCode::kMissingIndex:
+            return "missing-index";
+        case ErrorCode::kTrailingContent:
+            return "trailing-content";
+        case ErrorCode::kTooLarge:
+            return "too-large";
     }
     return "unknown";
 }

@@ -2,6 +2,7 @@
 // document, errors name the file and the place).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -20,7 +21,11 @@ struct CliRun {
 };
 
 CliRun run(const std::string& args) {
-    const auto err_path = std::filesystem::temp_directory_path() / "ncrev_cli_test.err";
+    // ctest runs tests in parallel processes: one stderr file per process and call.
+    static int calls = 0;
+    const auto err_path =
+        std::filesystem::temp_directory_path() /
+        ("ncrev_cli_test." + std::to_string(::getpid()) + "." + std::to_string(++calls) + ".err");
     const std::string cmd = std::string(NCREV_CLI_PATH) + " " + args + " 2>" + err_path.string();
     CliRun r;
     FILE* p = ::popen(cmd.c_str(), "r");
@@ -30,8 +35,11 @@ CliRun run(const std::string& args) {
     while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
     const int status = ::pclose(p);
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream e(err_path);
-    r.err.assign(std::istreambuf_iterator<char>(e), {});
+    {
+        std::ifstream e(err_path);
+        r.err.assign(std::istreambuf_iterator<char>(e), {});
+    }
+    std::filesystem::remove(err_path);
     return r;
 }
 
@@ -52,9 +60,9 @@ TEST(CliInfo, PrintsOneJsonDocumentWithTheDocumentedKeys) {
     EXPECT_EQ(j["input"]["facets"], 25);
     EXPECT_EQ(j["input"]["unit"], "mm");
     EXPECT_EQ(j["healing"]["duplicate_facets_removed"], 1);
-    for (const char* k : {"tolerance", "welded_vertices", "degenerate_facets_removed",
-                          "flipped_facets", "components_turned_outward", "nonmanifold_edges",
-                          "nonmanifold_vertices"}) {
+    for (const char* k :
+         {"tolerance", "welded_vertices", "degenerate_facets_removed", "flipped_facets",
+          "components_turned_outward", "nonmanifold_edges", "nonmanifold_vertices"}) {
         EXPECT_TRUE(j["healing"].contains(k)) << k;
     }
     EXPECT_EQ(j["mesh"]["vertices"], 16);
@@ -72,12 +80,13 @@ TEST(CliInfo, PrintsOneJsonDocumentWithTheDocumentedKeys) {
 }
 
 TEST(CliInfo, BadInputExitsTwoWithFileAndPlaceAndNoStdout) {
-    const auto path = write_temp("ncrev_cli_bad.stl",
-                                 test::bytes_of("solid x\nfacet normal 0 0 1\nouter lop\n"));
+    const auto path =
+        write_temp("ncrev_cli_bad.stl", test::bytes_of("solid x\nfacet normal 0 0 1\nouter lop\n"));
     const CliRun r = run("info --json " + path.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_EQ(r.out, "");
-    EXPECT_NE(r.err.find("error: " + path.string() + ": line 3: expected 'loop'"), std::string::npos)
+    EXPECT_NE(r.err.find("error: " + path.string() + ": line 3: expected 'loop'"),
+              std::string::npos)
         << r.err;
     std::filesystem::remove(path);
     const CliRun missing = run("info /nonexistent/file.stl");

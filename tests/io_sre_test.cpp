@@ -95,7 +95,8 @@ struct SreErrorCase {
     std::int64_t line;
 };
 
-std::string with_tail(const std::string& head, const std::string& facets = "facets 1\n0 1 2 0 -1 -1\n") {
+std::string with_tail(const std::string& head,
+                      const std::string& facets = "facets 1\n0 1 2 0 -1 -1\n") {
     return head + "vertices 3\n0 0 0\n1 0 0\n0 1 0\n" + facets;
 }
 
@@ -108,7 +109,8 @@ TEST(SreReader, ReportsEveryListedErrorWithItsLine) {
         {"header with extra field", "SRE 1 2\n", ErrorCode::kBadSyntax, 1},
         {"unknown version", "SRE 2\nsurfaces 0\n", ErrorCode::kBadValue, 1},
         {"unknown unit", "SRE 1\nunit furlong\n", ErrorCode::kBadValue, 2},
-        {"block out of order", "SRE 1\nvertices 0\nsurfaces 0\nfacets 0\n", ErrorCode::kBadSyntax, 2},
+        {"block out of order", "SRE 1\nvertices 0\nsurfaces 0\nfacets 0\n", ErrorCode::kBadSyntax,
+         2},
         {"tools after surfaces", "SRE 1\nsurfaces 0\ntools 0\n", ErrorCode::kBadSyntax, 3},
         {"missing facets block", "SRE 1\nsurfaces 0\nvertices 0\n", ErrorCode::kBadSyntax, 3},
         {"negative count", "SRE 1\nsurfaces -1\n", ErrorCode::kBadCount, 2},
@@ -129,11 +131,13 @@ TEST(SreReader, ReportsEveryListedErrorWithItsLine) {
         {"infinity", h + "vertices 1\n0 0 -inf\n", ErrorCode::kBadNumber, 4},
         {"integer with exponent", with_tail(h, "facets 1\n0 1 2e0 0 -1 -1\n"),
          ErrorCode::kBadNumber, 8},
-        {"unknown surface kind", "SRE 1\nsurfaces 1\n0 paraboloid 1 2 3\n", ErrorCode::kBadValue, 3},
+        {"unknown surface kind", "SRE 1\nsurfaces 1\n0 paraboloid 1 2 3\n", ErrorCode::kBadValue,
+         3},
         {"unknown tool kind", "SRE 1\ntools 1\ntool 5 router 10 0\n", ErrorCode::kBadValue, 3},
         {"tool with zero diameter", "SRE 1\ntools 1\ntool 5 flat 0 0\n", ErrorCode::kBadValue, 3},
         {"wrong parameter count", "SRE 1\nsurfaces 1\n0 sphere 0 0 0\n", ErrorCode::kBadSyntax, 3},
-        {"zero direction", "SRE 1\nsurfaces 1\n0 cylinder 0 0 0 0 0 0 1\n", ErrorCode::kBadValue, 3},
+        {"zero direction", "SRE 1\nsurfaces 1\n0 cylinder 0 0 0 0 0 0 1\n", ErrorCode::kBadValue,
+         3},
         {"zero plane normal", "SRE 1\nsurfaces 1\n0 plane 0 0 0 0 0 0\n", ErrorCode::kBadValue, 3},
         {"non-positive radius", "SRE 1\nsurfaces 1\n0 sphere 0 0 0 0\n", ErrorCode::kBadValue, 3},
         {"negative cylinder radius", "SRE 1\nsurfaces 1\n0 cylinder 0 0 0 0 0 1 -2\n",
@@ -146,8 +150,8 @@ TEST(SreReader, ReportsEveryListedErrorWithItsLine) {
          "SRE 1\nsurfaces 1\n0 shear_cylinder 0 0 0 0 0 1 2 1 0 0\n", ErrorCode::kBadValue, 3},
         {"duplicated surface index", "SRE 1\nsurfaces 2\n0 sphere 0 0 0 1\n0 sphere 0 0 0 2\n",
          ErrorCode::kDuplicateIndex, 4},
-        {"missing surface index",
-         "SRE 1\nsurfaces 2\n1 sphere 0 0 0 1\n2 sphere 0 0 0 2\n", ErrorCode::kIndexOutOfRange, 4},
+        {"missing surface index", "SRE 1\nsurfaces 2\n1 sphere 0 0 0 1\n2 sphere 0 0 0 2\n",
+         ErrorCode::kIndexOutOfRange, 4},
         {"surface index never given",
          "SRE 1\nsurfaces 3\n0 sphere 0 0 0 1\n2 sphere 0 0 0 2\n2 sphere 0 0 0 3\n",
          ErrorCode::kDuplicateIndex, 5},
@@ -158,7 +162,8 @@ TEST(SreReader, ReportsEveryListedErrorWithItsLine) {
         {"surface index out of range", with_tail(h, "facets 1\n0 1 2 0 -1 0\n"),
          ErrorCode::kIndexOutOfRange, 8},
         {"cut below -1", with_tail(h, "facets 1\n0 1 2 0 -2 -1\n"), ErrorCode::kBadValue, 8},
-        {"facet repeats a vertex", with_tail(h, "facets 1\n0 1 1 0 -1 -1\n"), ErrorCode::kBadValue, 8},
+        {"facet repeats a vertex", with_tail(h, "facets 1\n0 1 1 0 -1 -1\n"), ErrorCode::kBadValue,
+         8},
         {"trailing content", with_tail(h) + "extra words\n", ErrorCode::kTrailingContent, 9},
     };
     for (const auto& c : cases) {

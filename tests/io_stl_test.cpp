@@ -92,8 +92,9 @@ TEST(StlReader, ReportsEveryAsciiErrorWithItsLine) {
         {"ends inside a facet", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n",
          ErrorCode::kTruncated, 5},
         {"no endsolid", "solid x\n" + facet, ErrorCode::kTruncated, 9},
-        {"four vertices", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
-                          "vertex 0 1 0\nvertex 1 1 0\nendloop\n",
+        {"four vertices",
+         "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+         "vertex 0 1 0\nvertex 1 1 0\nendloop\n",
          ErrorCode::kBadSyntax, 7},
         {"junk instead of facet", "solid x\n" + facet + "hello\nendsolid x\n",
          ErrorCode::kBadSyntax, 9},

@@ -22,7 +22,8 @@ TEST(PlyWriter, WritesHeaderAndBinaryBodyWithFaceLabels) {
     PlyColumn red{"red", PlyColumn::Type::kUint8, {}};
     for (std::size_t f = 0; f < 12; ++f) {
         region.values.push_back(static_cast<double>(f / 2));
-        red.values.push_back(static_cast<double>((label_color(static_cast<std::uint32_t>(f / 2)) >> 16) & 0xff));
+        red.values.push_back(
+            static_cast<double>((label_color(static_cast<std::uint32_t>(f / 2)) >> 16) & 0xff));
     }
     const std::vector<PlyColumn> face_cols = {region, red};
     const auto bytes = encode_ply(c.points, c.triangles, {}, face_cols);
@@ -59,9 +60,7 @@ TEST(LabelColor, NeighbouringLabelsDiffer) {
 TEST(AtomicWrite, ReplacesExistingFileAndLeavesNoTemporary) {
     const auto dir = temp_dir("atomic");
     const auto path = dir / "out.stl";
-    {
-        std::ofstream(path) << "old";
-    }
+    { std::ofstream(path) << "old"; }
     const auto c = test::cube();
     ASSERT_TRUE(write_file_atomic(path, encode_stl_binary(c.points, c.triangles)).ok());
     EXPECT_EQ(std::filesystem::file_size(path), 84u + 50u * 12u);

@@ -124,9 +124,9 @@ TEST(MeshBuild, RemovesDegenerateFacets) {
     auto m = test::cube();
     m.points.push_back({0.5, 0, 0});  // on the edge 0-1
     const auto mid = static_cast<std::uint32_t>(m.points.size() - 1);
-    m.triangles.push_back({0, 0, 3});      // repeated vertex
-    m.triangles.push_back({0, 1, mid});    // zero area: three distinct, collinear vertices
-    m.triangles.push_back({2, 6, 2});      // repeated vertex
+    m.triangles.push_back({0, 0, 3});    // repeated vertex
+    m.triangles.push_back({0, 1, mid});  // zero area: three distinct, collinear vertices
+    m.triangles.push_back({2, 6, 2});    // repeated vertex
     auto b = build_ok(test::to_bucket(m));
     EXPECT_EQ(b.heal.degenerate_facets_removed, 3u);
     const MeshStats s = compute_stats(b.mesh);
@@ -298,7 +298,8 @@ TEST(MeshBuildInvariance, AsciiAndBinaryGiveTheSameMesh) {
     auto a = build_ok(*bin), c = build_ok(*asc);
     expect_same_stats(compute_stats(a.mesh), compute_stats(c.mesh), 0.0);
     EXPECT_EQ(a.mesh.origins().size(), c.mesh.origins().size());
-    EXPECT_TRUE(std::equal(a.mesh.origins().begin(), a.mesh.origins().end(), c.mesh.origins().begin()));
+    EXPECT_TRUE(
+        std::equal(a.mesh.origins().begin(), a.mesh.origins().end(), c.mesh.origins().begin()));
 }
 
 TEST(MeshBuildInvariance, AllFacetsFlippedGivesTheSameSolid) {

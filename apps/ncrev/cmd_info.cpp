@@ -29,11 +29,12 @@ void add_info(CLI::App& app, Context& ctx) {
     cmd->add_option("--tolerance", opts->tolerance,
                     "Weld distance in model units (default: 1e-6 x bounding-box diagonal, at "
                     "least 8 float32 ulps of the largest coordinate; 0: exact weld only)");
-    cmd->add_flag("-q,--quiet", opts->quiet, "No warnings on stderr");
+    cmd->add_flag("-q,--quiet", opts->quiet,
+                  "No warnings and no progress on stderr (progress is only shown on a terminal)");
     cmd->callback([opts, &ctx]() {
         HealOptions heal;
         heal.weld_tolerance = opts->tolerance;
-        auto report = inspect_file(opts->path, heal);
+        auto report = inspect_file(opts->path, heal, terminal_progress(ctx, opts->quiet));
         if (!report) {
             print_error(report.error().describe());
             ctx.exit_code = kExitBadInput;

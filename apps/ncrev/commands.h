@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace ncrev::cli {
@@ -34,6 +35,11 @@ struct Command {
 /// Registers a subcommand (called from a static initialiser in cmd_<name>.cpp).
 bool register_command(Command command);
 std::vector<Command>& registered_commands();
+
+/// Progress on the terminal: one line per stage on stderr ("ncrev: weld ... 0.12 s") when
+/// stderr is a terminal and not `quiet`; otherwise a no-op callback.
+std::function<void(std::string_view stage, double fraction)> terminal_progress(const Context& ctx,
+                                                                               bool quiet);
 
 /// Prints "error: <message>" to stderr.
 void print_error(const std::string& message);

@@ -3,8 +3,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "commands.h"
 
@@ -20,7 +22,28 @@ bool register_command(Command command) {
     return true;
 }
 
-void print_error(const std::string& message) { std::fprintf(stderr, "error: %s\n", message.c_str()); }
+std::function<void(std::string_view, double)> terminal_progress(const Context& ctx, bool quiet) {
+    if (quiet || !ctx.stderr_is_tty) return {};
+    struct State {
+        std::chrono::steady_clock::time_point start;
+    };
+    auto state = std::make_shared<State>();
+    return [state](std::string_view stage, double fraction) {
+        const auto now = std::chrono::steady_clock::now();
+        if (fraction <= 0.0) {
+            state->start = now;
+            std::fprintf(stderr, "ncrev: %.*s ...", static_cast<int>(stage.size()), stage.data());
+        } else if (fraction >= 1.0) {
+            std::fprintf(stderr, " %.2f s\n",
+                         std::chrono::duration<double>(now - state->start).count());
+        }
+        std::fflush(stderr);
+    };
+}
+
+void print_error(const std::string& message) {
+    std::fprintf(stderr, "error: %s\n", message.c_str());
+}
 void print_warning(const std::string& message) {
     std::fprintf(stderr, "warning: %s\n", message.c_str());
 }

@@ -90,21 +90,21 @@ using RegionId = Id<RegionTag>;
 
 /// What went wrong with an input or an output. The numeric value is stable (it names fixtures).
 enum class ErrorCode {
-    kCannotOpen,         ///< the file does not exist or cannot be read
-    kCannotWrite,        ///< the output cannot be written
-    kEmpty,              ///< zero bytes, or no facet at all
-    kUnknownFormat,      ///< not STL, not SRE
-    kTruncated,          ///< the file ends before what it announces
-    kSizeMismatch,       ///< binary STL: facet count disagrees with the file size
-    kBadNumber,          ///< a number that does not parse, or NaN / infinity
-    kBadSyntax,          ///< a keyword, field count or record out of place
-    kBadCount,           ///< a count that is not a non-negative integer, or records != count
-    kBadValue,           ///< a value out of its domain (zero direction, radius <= 0, ...)
-    kIndexOutOfRange,    ///< a vertex or surface index that names nothing
-    kDuplicateIndex,     ///< an SRE surface index given twice
-    kMissingIndex,       ///< an SRE surface index never given
-    kTrailingContent,    ///< content after the last block
-    kTooLarge,           ///< more elements than 32-bit ids can address
+    kCannotOpen,       ///< the file does not exist or cannot be read
+    kCannotWrite,      ///< the output cannot be written
+    kEmpty,            ///< zero bytes, or no facet at all
+    kUnknownFormat,    ///< not STL, not SRE
+    kTruncated,        ///< the file ends before what it announces
+    kSizeMismatch,     ///< binary STL: facet count disagrees with the file size
+    kBadNumber,        ///< a number that does not parse, or NaN / infinity
+    kBadSyntax,        ///< a keyword, field count or record out of place
+    kBadCount,         ///< a count that is not a non-negative integer, or records != count
+    kBadValue,         ///< a value out of its domain (zero direction, radius <= 0, ...)
+    kIndexOutOfRange,  ///< a vertex or surface index that names nothing
+    kDuplicateIndex,   ///< an SRE surface index given twice
+    kMissingIndex,     ///< an SRE surface index never given
+    kTrailingContent,  ///< content after the last block
+    kTooLarge,         ///< more elements than 32-bit ids can address
 };
 
 /// Short stable name of an error code (used in messages and JSON).
@@ -127,7 +127,7 @@ struct Error {
 template <class T>
 class [[nodiscard]] Result {
    public:
-    Result(T value) : v_(std::in_place_index<0>, std::move(value)) {}  // NOLINT: implicit
+    Result(T value) : v_(std::in_place_index<0>, std::move(value)) {}      // NOLINT: implicit
     Result(Error error) : v_(std::in_place_index<1>, std::move(error)) {}  // NOLINT: implicit
 
     bool ok() const { return v_.index() == 0; }

@@ -126,9 +126,10 @@ struct HealReport {
     std::uint64_t duplicate_facets_removed = 0;   ///< same three vertices as an earlier facet
     std::uint64_t flipped_facets = 0;             ///< minority side within each component
     std::uint64_t components_turned_outward = 0;  ///< closed components that were inside out
-    std::uint64_t nonmanifold_edges = 0;     ///< edges with more than two facets (then split)
-    std::uint64_t nonmanifold_vertices = 0;  ///< vertices with more than one fan (then split)
-    std::uint64_t orientation_conflicts = 0;  ///< edges cut to make a non-orientable part orientable
+    std::uint64_t nonmanifold_edges = 0;          ///< edges with more than two facets (then split)
+    std::uint64_t nonmanifold_vertices = 0;       ///< vertices with more than one fan (then split)
+    std::uint64_t orientation_conflicts =
+        0;  ///< edges cut to make a non-orientable part orientable
 };
 
 /// Numbers that describe a built mesh.

@@ -40,8 +40,8 @@ Result<FileBytes> FileBytes::open(const std::filesystem::path& path) {
     }
     FileBytes out;
     if (S_ISREG(st.st_mode) && st.st_size > 0) {
-        void* p = ::mmap(nullptr, static_cast<std::size_t>(st.st_size), PROT_READ, MAP_PRIVATE,
-                         fd, 0);
+        void* p =
+            ::mmap(nullptr, static_cast<std::size_t>(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
         if (p != MAP_FAILED) {
             ::madvise(p, static_cast<std::size_t>(st.st_size), MADV_SEQUENTIAL);
             out.data_ = static_cast<const std::byte*>(p);
@@ -102,13 +102,15 @@ Status write_file_atomic(const std::filesystem::path& path, std::span<const std:
     // A unique temporary name beside the target so that rename() is atomic (same filesystem).
     std::random_device rd;
     char suffix[32];
-    std::snprintf(suffix, sizeof suffix, ".tmp%08x%04x", rd(), static_cast<unsigned>(::getpid()) & 0xffffu);
+    std::snprintf(suffix, sizeof suffix, ".tmp%08x%04x", rd(),
+                  static_cast<unsigned>(::getpid()) & 0xffffu);
     std::string tmp_name = ".";
     tmp_name.append(path.filename().string()).append(suffix);
     const std::filesystem::path tmp = dir / tmp_name;
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (fd < 0) return fail(std::string("cannot create a file in ") + dir.string() + ": " +
-                            std::strerror(errno));
+    if (fd < 0)
+        return fail(std::string("cannot create a file in ") + dir.string() + ": " +
+                    std::strerror(errno));
     std::size_t done = 0;
     while (done < bytes.size()) {
         const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);

@@ -150,8 +150,8 @@ class SreParser {
             return error(ErrorCode::kBadSyntax, "expected header 'SRE 1', found " + quote(f[0]));
         }
         if (f.size() != 2) {
-            return error(ErrorCode::kBadSyntax, "header takes 2 fields ('SRE 1'), found " +
-                                                    std::to_string(f.size()));
+            return error(ErrorCode::kBadSyntax,
+                         "header takes 2 fields ('SRE 1'), found " + std::to_string(f.size()));
         }
         std::int64_t version = 0;
         if (!parse_int(f[1], version)) {
@@ -175,7 +175,8 @@ class SreParser {
         } else if (f[1] == "inch") {
             soup_.unit = Unit::kInch;
         } else {
-            return error(ErrorCode::kBadValue, "unknown unit " + quote(f[1]) + ", expected mm or inch");
+            return error(ErrorCode::kBadValue,
+                         "unknown unit " + quote(f[1]) + ", expected mm or inch");
         }
         return Ok{};
     }
@@ -225,22 +226,21 @@ class SreParser {
                          "count must be a non-negative integer, found " + quote(f[1]));
         }
         if (static_cast<std::uint64_t>(count) >= 0xFFFFFFFFull) {
-            return error(ErrorCode::kTooLarge, "count " + std::to_string(count) +
-                                                   " exceeds what 32-bit ids can address");
+            return error(ErrorCode::kTooLarge,
+                         "count " + std::to_string(count) + " exceeds what 32-bit ids can address");
         }
         announced_ = count;
         header_line_ = header_line;
         prev_block_ = keyword;
-        const std::size_t plausible =
-            std::min<std::size_t>(static_cast<std::size_t>(count), in_.remaining_bytes() / kMinRecordBytes + 1);
+        const std::size_t plausible = std::min<std::size_t>(
+            static_cast<std::size_t>(count), in_.remaining_bytes() / kMinRecordBytes + 1);
         reserve(keyword, plausible, static_cast<std::size_t>(count));
         for (std::int64_t i = 0; i < count; ++i) {
             if (!in_.next()) {
                 return error(ErrorCode::kBadCount,
                              "file ends after " + std::to_string(i) + " of the " +
-                                 std::to_string(count) + " records block '" +
-                                 std::string(keyword) + "' announced (line " +
-                                 std::to_string(header_line) + ")");
+                                 std::to_string(count) + " records block '" + std::string(keyword) +
+                                 "' announced (line " + std::to_string(header_line) + ")");
             }
             if (is_block_keyword(in_.fields()[0])) {
                 return error(ErrorCode::kBadCount,
@@ -294,11 +294,13 @@ class SreParser {
 
     Status tool_record() {
         const auto& f = in_.fields();
-        if (f[0] != "tool") return error(ErrorCode::kBadSyntax, "expected 'tool', found " + quote(f[0]));
+        if (f[0] != "tool")
+            return error(ErrorCode::kBadSyntax, "expected 'tool', found " + quote(f[0]));
         if (f.size() < 5) {
             return error(ErrorCode::kBadSyntax,
                          "a tool record takes at least 5 fields (tool color kind diameter "
-                         "corner_radius [name]), found " + std::to_string(f.size()));
+                         "corner_radius [name]), found " +
+                             std::to_string(f.size()));
         }
         ToolRecord t;
         if (auto s = integer(f[1], t.color); !s) return s;
@@ -310,8 +312,9 @@ class SreParser {
             }
         }
         if (!known) {
-            return error(ErrorCode::kBadValue, "unknown tool kind " + quote(f[2]) +
-                                                   ", expected flat, ball, bullnose, drill or other");
+            return error(ErrorCode::kBadValue,
+                         "unknown tool kind " + quote(f[2]) +
+                             ", expected flat, ball, bullnose, drill or other");
         }
         if (auto s = number(f[3], t.diameter); !s) return s;
         if (auto s = number(f[4], t.corner_radius); !s) return s;
@@ -330,8 +333,9 @@ class SreParser {
     Status surface_record() {
         const auto& f = in_.fields();
         if (f.size() < 2) {
-            return error(ErrorCode::kBadSyntax, "a surface record takes an index, a kind and its "
-                                                "parameters, found 1 field");
+            return error(ErrorCode::kBadSyntax,
+                         "a surface record takes an index, a kind and its "
+                         "parameters, found 1 field");
         }
         std::int64_t index = 0;
         if (auto s = integer(f[0], index); !s) return s;
@@ -435,8 +439,9 @@ class SreParser {
         for (std::size_t i = 0; i < surface_seen_line_.size(); ++i) {
             if (surface_seen_line_[i] == 0) {
                 return error(ErrorCode::kMissingIndex,
-                             "surface index " + std::to_string(i) + " is missing (block announced " +
-                                 std::to_string(surface_count_) + ")",
+                             "surface index " + std::to_string(i) +
+                                 " is missing (block announced " + std::to_string(surface_count_) +
+                                 ")",
                              header_line_);
             }
         }
@@ -468,9 +473,9 @@ class SreParser {
         const auto num_vertices = static_cast<std::int64_t>(soup_.points.size());
         for (int i = 0; i < 3; ++i) {
             if (v[i] < 0 || v[i] >= num_vertices) {
-                return error(ErrorCode::kIndexOutOfRange,
-                             "vertex index " + std::to_string(v[i]) + " out of range 0.." +
-                                 std::to_string(num_vertices - 1));
+                return error(ErrorCode::kIndexOutOfRange, "vertex index " + std::to_string(v[i]) +
+                                                              " out of range 0.." +
+                                                              std::to_string(num_vertices - 1));
             }
         }
         if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) {
@@ -482,11 +487,12 @@ class SreParser {
         }
         const auto num_surfaces = static_cast<std::int64_t>(soup_.surfaces.size());
         if (surface < -1 || surface >= num_surfaces) {
-            return error(ErrorCode::kIndexOutOfRange,
-                         "surface index " + std::to_string(surface) + " out of range (-1 or 0.." +
-                             std::to_string(num_surfaces - 1) + ")");
+            return error(ErrorCode::kIndexOutOfRange, "surface index " + std::to_string(surface) +
+                                                          " out of range (-1 or 0.." +
+                                                          std::to_string(num_surfaces - 1) + ")");
         }
-        soup_.triangles.push_back({static_cast<std::uint32_t>(v[0]), static_cast<std::uint32_t>(v[1]),
+        soup_.triangles.push_back({static_cast<std::uint32_t>(v[0]),
+                                   static_cast<std::uint32_t>(v[1]),
                                    static_cast<std::uint32_t>(v[2])});
         soup_.color.push_back(color);
         soup_.cut.push_back(cut);
@@ -520,8 +526,9 @@ Result<TriangleSoup> read_sre(std::span<const std::byte> bytes, std::string_view
 namespace {
 
 bool begins_with_sre_header(std::span<const std::byte> bytes) {
-    RecordReader r(reinterpret_cast<const char*>(bytes.data()),
-                   reinterpret_cast<const char*>(bytes.data()) + std::min<std::size_t>(bytes.size(), 4096));
+    RecordReader r(
+        reinterpret_cast<const char*>(bytes.data()),
+        reinterpret_cast<const char*>(bytes.data()) + std::min<std::size_t>(bytes.size(), 4096));
     return r.next() && r.fields()[0] == "SRE";
 }
 

@@ -17,8 +17,8 @@ constexpr std::size_t kStlRecordBytes = 50;  // normal, 3 vertices (12 float32),
 // Three 32-bit point ids per facet: beyond this many facets the ids would overflow.
 constexpr std::uint64_t kMaxFacets = 0xFFFFFFFEull / 3;
 
-Error make_error(ErrorCode code, std::string_view name, std::string message,
-                 std::int64_t line = -1, std::int64_t offset = -1) {
+Error make_error(ErrorCode code, std::string_view name, std::string message, std::int64_t line = -1,
+                 std::int64_t offset = -1) {
     Error e;
     e.code = code;
     e.path = std::string(name);
@@ -65,8 +65,8 @@ Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_v
             int k = 0;
             while (std::isfinite(c[k])) ++k;
             return make_error(ErrorCode::kBadNumber, name,
-                              "facet " + std::to_string(f) + " has a non-finite coordinate",
-                              -1, static_cast<std::int64_t>(rec - bytes.data()) + 12 + 4 * k);
+                              "facet " + std::to_string(f) + " has a non-finite coordinate", -1,
+                              static_cast<std::int64_t>(rec - bytes.data()) + 12 + 4 * k);
         }
         out[3 * f + 0] = {c[0], c[1], c[2]};
         out[3 * f + 1] = {c[3], c[4], c[5]};
@@ -197,7 +197,8 @@ Result<TriangleSoup> read_stl(std::span<const std::byte> bytes, std::string_view
     std::uint64_t n = 0;
     const bool has_header = size >= kStlHeaderBytes;
     if (has_header) n = load_u32(bytes.data() + 80);
-    if (has_header && kStlHeaderBytes + kStlRecordBytes * n == size) return read_binary(bytes, name);
+    if (has_header && kStlHeaderBytes + kStlRecordBytes * n == size)
+        return read_binary(bytes, name);
 
     const bool looks_ascii = starts_with_solid(bytes);
     auto binary_size_error = [&]() -> Error {

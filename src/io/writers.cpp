@@ -8,9 +8,12 @@ namespace ncrev {
 
 const char* to_string(InputFormat format) {
     switch (format) {
-        case InputFormat::kStlBinary: return "stl-binary";
-        case InputFormat::kStlAscii: return "stl-ascii";
-        case InputFormat::kSre: return "sre";
+        case InputFormat::kStlBinary:
+            return "stl-binary";
+        case InputFormat::kStlAscii:
+            return "stl-ascii";
+        case InputFormat::kSre:
+            return "sre";
     }
     return "unknown";
 }
@@ -19,37 +22,56 @@ const char* to_string(Unit unit) { return unit == Unit::kInch ? "inch" : "mm"; }
 
 const char* to_string(SurfaceKind kind) {
     switch (kind) {
-        case SurfaceKind::kPlane: return "plane";
-        case SurfaceKind::kCylinder: return "cylinder";
-        case SurfaceKind::kCone: return "cone";
-        case SurfaceKind::kSphere: return "sphere";
-        case SurfaceKind::kTorus: return "torus";
-        case SurfaceKind::kShearCylinder: return "shear_cylinder";
-        case SurfaceKind::kSweptTorus: return "swept_torus";
+        case SurfaceKind::kPlane:
+            return "plane";
+        case SurfaceKind::kCylinder:
+            return "cylinder";
+        case SurfaceKind::kCone:
+            return "cone";
+        case SurfaceKind::kSphere:
+            return "sphere";
+        case SurfaceKind::kTorus:
+            return "torus";
+        case SurfaceKind::kShearCylinder:
+            return "shear_cylinder";
+        case SurfaceKind::kSweptTorus:
+            return "swept_torus";
     }
     return "unknown";
 }
 
 int num_surface_params(SurfaceKind kind) {
     switch (kind) {
-        case SurfaceKind::kPlane: return 6;
-        case SurfaceKind::kCylinder: return 7;
-        case SurfaceKind::kCone: return 8;
-        case SurfaceKind::kSphere: return 4;
-        case SurfaceKind::kTorus: return 8;
-        case SurfaceKind::kShearCylinder: return 10;
-        case SurfaceKind::kSweptTorus: return 11;
+        case SurfaceKind::kPlane:
+            return 6;
+        case SurfaceKind::kCylinder:
+            return 7;
+        case SurfaceKind::kCone:
+            return 8;
+        case SurfaceKind::kSphere:
+            return 4;
+        case SurfaceKind::kTorus:
+            return 8;
+        case SurfaceKind::kShearCylinder:
+            return 10;
+        case SurfaceKind::kSweptTorus:
+            return 11;
     }
     return 0;
 }
 
 const char* to_string(ToolKind kind) {
     switch (kind) {
-        case ToolKind::kFlat: return "flat";
-        case ToolKind::kBall: return "ball";
-        case ToolKind::kBullnose: return "bullnose";
-        case ToolKind::kDrill: return "drill";
-        case ToolKind::kOther: return "other";
+        case ToolKind::kFlat:
+            return "flat";
+        case ToolKind::kBall:
+            return "ball";
+        case ToolKind::kBullnose:
+            return "bullnose";
+        case ToolKind::kDrill:
+            return "drill";
+        case ToolKind::kOther:
+            return "other";
     }
     return "other";
 }
@@ -198,9 +220,12 @@ std::vector<std::byte> encode_ply(std::span<const Vec3> points,
                                   std::span<const PlyColumn> face_columns) {
     auto type_name = [](PlyColumn::Type t) {
         switch (t) {
-            case PlyColumn::Type::kFloat32: return "float";
-            case PlyColumn::Type::kInt32: return "int";
-            case PlyColumn::Type::kUint8: return "uchar";
+            case PlyColumn::Type::kFloat32:
+                return "float";
+            case PlyColumn::Type::kInt32:
+                return "int";
+            case PlyColumn::Type::kUint8:
+                return "uchar";
         }
         return "float";
     };
@@ -224,9 +249,15 @@ std::vector<std::byte> encode_ply(std::span<const Vec3> points,
     auto put_value = [&](const PlyColumn& c, std::size_t i) {
         const double v = i < c.values.size() ? c.values[i] : 0.0;
         switch (c.type) {
-            case PlyColumn::Type::kFloat32: put(out, static_cast<float>(v)); break;
-            case PlyColumn::Type::kInt32: put(out, static_cast<std::int32_t>(v)); break;
-            case PlyColumn::Type::kUint8: put(out, static_cast<std::uint8_t>(v)); break;
+            case PlyColumn::Type::kFloat32:
+                put(out, static_cast<float>(v));
+                break;
+            case PlyColumn::Type::kInt32:
+                put(out, static_cast<std::int32_t>(v));
+                break;
+            case PlyColumn::Type::kUint8:
+                put(out, static_cast<std::uint8_t>(v));
+                break;
         }
     };
     for (std::size_t i = 0; i < points.size(); ++i) {
@@ -255,12 +286,36 @@ std::uint32_t label_color(std::uint32_t i) {
     const double p = v * (1 - s), q = v * (1 - s * frac), t = v * (1 - s * (1 - frac));
     double r = v, g = t, b = p;
     switch (sector % 6) {
-        case 0: r = v; g = t; b = p; break;
-        case 1: r = q; g = v; b = p; break;
-        case 2: r = p; g = v; b = t; break;
-        case 3: r = p; g = q; b = v; break;
-        case 4: r = t; g = p; b = v; break;
-        default: r = v; g = p; b = q; break;
+        case 0:
+            r = v;
+            g = t;
+            b = p;
+            break;
+        case 1:
+            r = q;
+            g = v;
+            b = p;
+            break;
+        case 2:
+            r = p;
+            g = v;
+            b = t;
+            break;
+        case 3:
+            r = p;
+            g = q;
+            b = v;
+            break;
+        case 4:
+            r = t;
+            g = p;
+            b = v;
+            break;
+        default:
+            r = v;
+            g = p;
+            b = q;
+            break;
     }
     auto byte = [](double x) { return static_cast<std::uint32_t>(std::lround(x * 255.0)); };
     return (byte(r) << 16) | (byte(g) << 8) | byte(b);

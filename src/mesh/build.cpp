@@ -527,8 +527,8 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
                 }
                 const Vec3 p0 = vpos[t[0]], p1 = vpos[t[1]], p2 = vpos[t[2]];
                 const double area2 = norm(cross(p1 - p0, p2 - p0));
-                const double longest = std::sqrt(
-                    std::max({dot(p1 - p0, p1 - p0), dot(p2 - p1, p2 - p1), dot(p0 - p2, p0 - p2)}));
+                const double longest = std::sqrt(std::max(
+                    {dot(p1 - p0, p1 - p0), dot(p2 - p1, p2 - p1), dot(p0 - p2, p0 - p2)}));
                 // twice the area / longest edge = the smallest height of the triangle
                 if (area2 <= tol * longest) bad[k] = 1;
             }

@@ -1,8 +1,8 @@
 // Mesh queries, invariant checks and statistics.
+#include "ncrev/mesh.h"
+
 #include <algorithm>
 #include <numeric>
-
-#include "ncrev/mesh.h"
 
 namespace ncrev {
 
@@ -16,7 +16,8 @@ std::string Mesh::validate() const {
     if (nh % 3 != 0) return "half-edge count is not a multiple of 3";
     if (twin_.size() != nh) return "twin column size differs from origin column";
     if (outgoing_.size() != nv) return "outgoing column size differs from vertex count";
-    if (source_face_.size() != num_faces()) return "source-face column size differs from face count";
+    if (source_face_.size() != num_faces())
+        return "source-face column size differs from face count";
     if (!color_.empty() && (color_.size() != num_faces() || cut_.size() != num_faces() ||
                             surface_.size() != num_faces())) {
         return "attribute column sizes differ from face count";
@@ -66,8 +67,9 @@ std::string Mesh::validate() const {
             return "boundary vertex " + str(v) + " has an outgoing half-edge with a twin";
         }
         if (count != total[v]) {
-            return "vertex " + str(v) + " has " + str(total[v]) + " outgoing half-edges but its fan holds " +
-                   str(count) + " (non-manifold vertex)";
+            return "vertex " + str(v) + " has " + str(total[v]) +
+                   " outgoing half-edges but its fan holds " + str(count) +
+                   " (non-manifold vertex)";
         }
     }
     return {};
@@ -84,7 +86,8 @@ MeshStats compute_stats(const Mesh& mesh) {
     s.boundary_edges = boundary;
     s.edges = (nh - boundary) / 2 + boundary;
     s.euler_characteristic = static_cast<std::int64_t>(s.vertices) -
-                             static_cast<std::int64_t>(s.edges) + static_cast<std::int64_t>(s.faces);
+                             static_cast<std::int64_t>(s.edges) +
+                             static_cast<std::int64_t>(s.faces);
     s.closed = boundary == 0 && nf > 0;
 
     // Area and volume, the volume about the box center for precision.

@@ -14,7 +14,8 @@ std::vector<std::string> make_warnings(const InfoReport& r) {
     if (r.unit_assumed) w.push_back("STL has no unit: millimetres assumed");
     if (r.mesh.faces == 0) w.push_back("no facet left after healing");
     if (r.heal.welded_vertices) {
-        w.push_back(n(r.heal.welded_vertices) + " vertices welded within the tolerance (cracks closed)");
+        w.push_back(n(r.heal.welded_vertices) +
+                    " vertices welded within the tolerance (cracks closed)");
     }
     if (r.heal.degenerate_facets_removed) {
         w.push_back(n(r.heal.degenerate_facets_removed) + " degenerate facets removed");
@@ -22,11 +23,13 @@ std::vector<std::string> make_warnings(const InfoReport& r) {
     if (r.heal.duplicate_facets_removed) {
         w.push_back(n(r.heal.duplicate_facets_removed) + " duplicate facets removed");
     }
-    if (r.heal.flipped_facets) w.push_back(n(r.heal.flipped_facets) + " facets flipped to agree with their neighbours");
+    if (r.heal.flipped_facets)
+        w.push_back(n(r.heal.flipped_facets) + " facets flipped to agree with their neighbours");
     if (r.heal.components_turned_outward) {
         w.push_back(n(r.heal.components_turned_outward) + " inside-out components turned outward");
     }
-    if (r.heal.nonmanifold_edges) w.push_back(n(r.heal.nonmanifold_edges) + " non-manifold edges split");
+    if (r.heal.nonmanifold_edges)
+        w.push_back(n(r.heal.nonmanifold_edges) + " non-manifold edges split");
     if (r.heal.nonmanifold_vertices) {
         w.push_back(n(r.heal.nonmanifold_vertices) + " non-manifold vertices split");
     }
@@ -144,15 +147,15 @@ std::string to_text(const InfoReport& r) {
                   static_cast<unsigned long long>(h.nonmanifold_edges),
                   static_cast<unsigned long long>(h.nonmanifold_vertices));
     s += buf;
-    std::snprintf(buf, sizeof buf,
-                  "mesh: %llu vertices, %llu facets, %llu edges, %llu components, %s "
-                  "(%llu boundary loops, %llu boundary edges), Euler characteristic %lld\n",
-                  static_cast<unsigned long long>(m.vertices),
-                  static_cast<unsigned long long>(m.faces), static_cast<unsigned long long>(m.edges),
-                  static_cast<unsigned long long>(m.components), m.closed ? "closed" : "open",
-                  static_cast<unsigned long long>(m.boundary_loops),
-                  static_cast<unsigned long long>(m.boundary_edges),
-                  static_cast<long long>(m.euler_characteristic));
+    std::snprintf(
+        buf, sizeof buf,
+        "mesh: %llu vertices, %llu facets, %llu edges, %llu components, %s "
+        "(%llu boundary loops, %llu boundary edges), Euler characteristic %lld\n",
+        static_cast<unsigned long long>(m.vertices), static_cast<unsigned long long>(m.faces),
+        static_cast<unsigned long long>(m.edges), static_cast<unsigned long long>(m.components),
+        m.closed ? "closed" : "open", static_cast<unsigned long long>(m.boundary_loops),
+        static_cast<unsigned long long>(m.boundary_edges),
+        static_cast<long long>(m.euler_characteristic));
     s += buf;
     if (!m.bbox.empty()) {
         const Vec3 d = m.bbox.max - m.bbox.min;
