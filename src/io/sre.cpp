@@ -534,19 +534,20 @@ bool begins_with_sre_header(std::span<const std::byte> bytes) {
 
 }  // namespace
 
-Result<TriangleSoup> read_mesh(std::span<const std::byte> bytes, std::string_view name) {
+Result<TriangleSoup> read_mesh(std::span<const std::byte> bytes, std::string_view name,
+                               const ReadOptions& options) {
     if (begins_with_sre_header(bytes)) return read_sre(bytes, name);
-    return read_stl(bytes, name);
+    return read_stl(bytes, name, options);
 }
 
-Result<TriangleSoup> read_mesh_file(const std::filesystem::path& path) {
+Result<TriangleSoup> read_mesh_file(const std::filesystem::path& path, const ReadOptions& options) {
     auto file = FileBytes::open(path);
     if (!file) return file.error();
     const std::string name = path.string();
     std::string ext = path.extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (ext == ".sre") return read_sre(file->bytes(), name);
-    return read_mesh(file->bytes(), name);
+    return read_mesh(file->bytes(), name, options);
 }
 
 }  // namespace ncrev

@@ -1,7 +1,9 @@
 // STL reader (ASCII and binary). Binary is recognised by its size, 84 + 50·n bytes with n the
 // header's facet count, because many binary files begin with the word "solid".
+#include <bit>
 #include <cstring>
 
+#include "detail/exact_weld.h"
 #include "io/text.h"
 #include "ncrev/io.h"
 
@@ -34,7 +36,37 @@ std::uint32_t load_u32(const std::byte* p) {
     return v;
 }
 
-Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_view name) {
+std::uint32_t float_key(float v) {
+    const auto b = std::bit_cast<std::uint32_t>(v);
+    return b == 0x80000000u ? 0u : b;  // -0 and +0 are the same point
+}
+
+/// Exact weld of a bucket soup whose points are float32 values (as every STL's are).
+void weld_float_points(TriangleSoup& soup) {
+    detail::ExactWelder<std::uint32_t> welder(soup.points.size());
+    std::vector<std::uint32_t> id(soup.points.size());
+    for (std::size_t i = 0; i < soup.points.size(); ++i) {
+        const Vec3 p = soup.points[i];
+        id[i] =
+            welder.insert({float_key(static_cast<float>(p.x)), float_key(static_cast<float>(p.y)),
+                           float_key(static_cast<float>(p.z))});
+    }
+    for (auto& t : soup.triangles) {
+        for (auto& v : t) v = id[v];
+    }
+    soup.welded_points = soup.points.size() - welder.size();
+    soup.points.resize(welder.size());
+    for (std::size_t c = 0; c < welder.size(); ++c) {
+        const auto& k = welder.keys()[c];
+        soup.points[c] = {std::bit_cast<float>(k[0]), std::bit_cast<float>(k[1]),
+                          std::bit_cast<float>(k[2])};
+    }
+    soup.points.shrink_to_fit();
+    soup.points_distinct = true;
+}
+
+Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_view name,
+                                 bool weld) {
     const std::uint64_t n = load_u32(bytes.data() + 80);
     if (n > kMaxFacets) {
         return make_error(ErrorCode::kTooLarge, name,
@@ -52,9 +84,51 @@ Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_v
         while (!header.empty() && io_detail::is_space(header.back())) header.remove_suffix(1);
         for (char c : header) soup.name += (c >= 0x20 && c < 0x7f) ? c : '?';
     }
-    soup.points.resize(3 * n);
     soup.triangles.resize(n);
     const std::byte* rec = bytes.data() + kStlHeaderBytes;
+    if (weld) {
+        // Weld while reading: the soup holds each vertex once (a third of the memory of
+        // three points per facet) and the keys are the file's own float32 bits.
+        detail::ExactWelder<std::uint32_t> welder(3 * n);
+        // Prefetch the table slots of the vertices a few facets ahead: a new vertex (one in
+        // six) misses the large table, and its cost is a memory round trip otherwise.
+        constexpr std::uint64_t kPrefetchFacets = 8;
+        for (std::uint64_t f = 0; f < n; ++f, rec += kStlRecordBytes) {
+            float c[9];
+            std::memcpy(c, rec + 12, sizeof c);
+            bool finite = true;
+            for (float v : c) finite &= std::isfinite(v);
+            if (!finite) {
+                int k = 0;
+                while (std::isfinite(c[k])) ++k;
+                return make_error(ErrorCode::kBadNumber, name,
+                                  "facet " + std::to_string(f) + " has a non-finite coordinate", -1,
+                                  static_cast<std::int64_t>(rec - bytes.data()) + 12 + 4 * k);
+            }
+            if (f + kPrefetchFacets < n) {
+                float a[9];
+                std::memcpy(a, rec + kPrefetchFacets * kStlRecordBytes + 12, sizeof a);
+                for (int k = 0; k < 3; ++k) {
+                    welder.prefetch(
+                        {float_key(a[3 * k]), float_key(a[3 * k + 1]), float_key(a[3 * k + 2])});
+                }
+            }
+            for (int k = 0; k < 3; ++k) {
+                soup.triangles[f][k] = welder.insert(
+                    {float_key(c[3 * k]), float_key(c[3 * k + 1]), float_key(c[3 * k + 2])});
+            }
+        }
+        soup.points.resize(welder.size());
+        for (std::size_t i = 0; i < welder.size(); ++i) {
+            const auto& k = welder.keys()[i];
+            soup.points[i] = {std::bit_cast<float>(k[0]), std::bit_cast<float>(k[1]),
+                              std::bit_cast<float>(k[2])};
+        }
+        soup.welded_points = 3 * n - welder.size();
+        soup.points_distinct = true;
+        return soup;
+    }
+    soup.points.resize(3 * n);
     Vec3* out = soup.points.data();
     for (std::uint64_t f = 0; f < n; ++f, rec += kStlRecordBytes) {
         float c[9];
@@ -191,14 +265,16 @@ bool starts_with_solid(std::span<const std::byte> bytes) {
 
 }  // namespace
 
-Result<TriangleSoup> read_stl(std::span<const std::byte> bytes, std::string_view name) {
+Result<TriangleSoup> read_stl(std::span<const std::byte> bytes, std::string_view name,
+                              const ReadOptions& options) {
     if (bytes.empty()) return make_error(ErrorCode::kEmpty, name, "file is empty");
     const std::uint64_t size = bytes.size();
     std::uint64_t n = 0;
     const bool has_header = size >= kStlHeaderBytes;
     if (has_header) n = load_u32(bytes.data() + 80);
-    if (has_header && kStlHeaderBytes + kStlRecordBytes * n == size)
-        return read_binary(bytes, name);
+    if (has_header && kStlHeaderBytes + kStlRecordBytes * n == size) {
+        return read_binary(bytes, name, options.weld_exact);
+    }
 
     const bool looks_ascii = starts_with_solid(bytes);
     auto binary_size_error = [&]() -> Error {
@@ -224,6 +300,7 @@ Result<TriangleSoup> read_stl(std::span<const std::byte> bytes, std::string_view
     };
     if (!looks_ascii) return binary_size_error();
     auto ascii = read_ascii(bytes, name);
+    if (ascii.ok() && options.weld_exact) weld_float_points(*ascii);
     if (ascii.ok() || !has_header) return ascii;
     // A file that begins with "solid" but holds NUL bytes is a binary STL whose size is off:
     // say that rather than report an ASCII syntax error on binary data.

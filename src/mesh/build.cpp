@@ -15,6 +15,7 @@
 #include <cstring>
 #include <numeric>
 
+#include "detail/exact_weld.h"
 #include "ncrev/mesh.h"
 
 namespace ncrev {
@@ -41,21 +42,6 @@ std::uint64_t bits_of(double v) {
     return std::bit_cast<std::uint64_t>(v);
 }
 
-std::uint64_t hash_point(const Vec3& p) {
-    std::uint64_t h = bits_of(p.x) * 0x9E3779B97F4A7C15ull;
-    h ^= std::rotl(bits_of(p.y) * 0xC2B2AE3D27D4EB4Full, 21);
-    h ^= std::rotl(bits_of(p.z) * 0x165667B19E3779F9ull, 42);
-    h ^= h >> 29;
-    h *= 0xBF58476D1CE4E5B9ull;
-    h ^= h >> 32;
-    return h;
-}
-
-bool same_point(const Vec3& a, const Vec3& b) {
-    return bits_of(a.x) == bits_of(b.x) && bits_of(a.y) == bits_of(b.y) &&
-           bits_of(a.z) == bits_of(b.z);
-}
-
 template <class Fn>
 void for_chunks(std::size_t n, Fn&& fn) {
     const std::size_t chunks = (n + kChunk - 1) / kChunk;
@@ -67,84 +53,28 @@ void for_chunks(std::size_t n, Fn&& fn) {
                       });
 }
 
-/// Exact weld: id[i] = class of point i, classes numbered by first occurrence; pos[k] = the
-/// position of class k. Returns the number of classes.
-///
-/// One pass in input order over an open-addressing table of (hash, class) slots. Input order
-/// matters for speed: a vertex recurs in facets written close together, so the comparison
-/// with its first occurrence usually hits the cache. (A hash-partitioned parallel version was
-/// measured 5x slower on 2 cores: it scatters the accesses to the points.)
+/// Exact weld of float64 points: id[i] = class of point i, classes numbered by first
+/// occurrence; pos[k] = the position of class k. Returns the number of classes.
 std::uint32_t weld_exact(std::span<const Vec3> pts, std::vector<std::uint32_t>& id,
                          std::vector<Vec3>& pos) {
     const std::size_t n = pts.size();
     id.resize(n);
-    pos.clear();
-    // Facet soups hold each vertex about six times: start at a quarter of the points.
-    std::size_t cap = std::bit_ceil(std::max<std::size_t>(1024, n / 4));
-    std::vector<std::uint64_t> table(cap, 0);  // (hash high 32 << 32) | (class + 1); 0 empty
-    // A direct-mapped cache of recent classes, tagged with the hash's high bits so that a
-    // stale entry is rejected without touching the positions: a vertex recurs within a few
-    // rows of facets (a few thousand points later) and is then found without the large table.
-    // 32768 entries x 8 bytes = 256 KiB fits L2 and keeps ~90% of entries alive across 3000
-    // intervening points.
-    constexpr std::size_t kRecent = 1 << 15;
-    // Prefetch distance for the large table (points ahead): hides the miss of a new vertex.
-    constexpr std::size_t kPrefetchAhead = 16;
-    std::vector<std::uint64_t> recent(kRecent, 0);
+    detail::ExactWelder<std::uint64_t> welder(n);
+    auto key = [](const Vec3& p) {
+        return detail::ExactWelder<std::uint64_t>::Key{bits_of(p.x), bits_of(p.y), bits_of(p.z)};
+    };
+    constexpr std::size_t kPrefetchAhead = 16;  // points: hides the table miss of new vertices
     for (std::size_t i = 0; i < n; ++i) {
-        if (i + kPrefetchAhead < n) {
-            __builtin_prefetch(&table[hash_point(pts[i + kPrefetchAhead]) & (cap - 1)]);
-        }
-        const Vec3& q = pts[i];
-        const std::uint64_t h = hash_point(q);
-        const auto h32 = static_cast<std::uint32_t>(h >> 32);
-        std::uint64_t& hint = recent[(h >> 17) & (kRecent - 1)];
-        if (static_cast<std::uint32_t>(hint >> 32) == h32 && hint != 0) {
-            const auto c = static_cast<std::uint32_t>(hint) - 1;
-            if (same_point(pos[c], q)) {
-                id[i] = c;
-                continue;
-            }
-        }
-        std::size_t mask = cap - 1;
-        std::size_t s = h & mask;
-        std::uint32_t found = kNone;
-        while (table[s] != 0) {
-            const std::uint64_t entry = table[s];
-            if (static_cast<std::uint32_t>(entry >> 32) == h32) {
-                const auto c = static_cast<std::uint32_t>(entry) - 1;
-                if (same_point(pos[c], q)) {
-                    found = c;
-                    break;
-                }
-            }
-            s = (s + 1) & mask;
-        }
-        if (found != kNone) {
-            id[i] = found;
-            hint = (std::uint64_t{h32} << 32) | (found + 1);
-            continue;
-        }
-        const auto c = static_cast<std::uint32_t>(pos.size());
-        pos.push_back(q);
-        id[i] = c;
-        hint = (std::uint64_t{h32} << 32) | (c + 1);
-        table[s] = (std::uint64_t{h32} << 32) | (c + 1);
-        if (2 * pos.size() > cap) {
-            // Rehash from the positions (the slots keep only 32 bits of the hash).
-            cap *= 2;
-            mask = cap - 1;
-            std::vector<std::uint64_t> bigger(cap, 0);
-            for (std::uint32_t k = 0; k < pos.size(); ++k) {
-                const std::uint64_t hk = hash_point(pos[k]);
-                std::size_t t = hk & mask;
-                while (bigger[t] != 0) t = (t + 1) & mask;
-                bigger[t] = ((hk >> 32) << 32) | (k + 1);
-            }
-            table.swap(bigger);
-        }
+        if (i + kPrefetchAhead < n) welder.prefetch(key(pts[i + kPrefetchAhead]));
+        id[i] = welder.insert(key(pts[i]));
     }
-    return static_cast<std::uint32_t>(pos.size());
+    pos.resize(welder.size());
+    for (std::size_t c = 0; c < welder.size(); ++c) {
+        const auto& k = welder.keys()[c];
+        pos[c] = {std::bit_cast<double>(k[0]), std::bit_cast<double>(k[1]),
+                  std::bit_cast<double>(k[2])};
+    }
+    return static_cast<std::uint32_t>(welder.size());
 }
 
 /// Union-find whose root is always the smallest index of its set: the result does not depend
@@ -461,7 +391,6 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     BuildResult out;
     HealReport& rep = out.heal;
     rep.input_facets = num_in;
-    rep.input_points = num_points;
 
     // Bounding box of the input points, and the tolerance.
     Box3 box;
@@ -487,13 +416,25 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     }
     const double tol = rep.tolerance;
 
-    // 1. Exact weld: point -> vertex.
+    // 1. Exact weld: point -> vertex (unless the reader already welded).
     report_progress("weld", 0.0);
     std::vector<std::uint32_t> point_vertex;
     std::vector<Vec3> vpos;
-    const std::uint32_t num_exact = weld_exact(soup.points, point_vertex, vpos);
-    rep.exact_welded_points = num_points - num_exact;
-    if (owned) owned->points = {};  // from here on only vpos is read
+    rep.input_points = num_points + soup.welded_points;
+    if (soup.points_distinct) {
+        rep.exact_welded_points = soup.welded_points;
+        point_vertex.resize(num_points);
+        std::iota(point_vertex.begin(), point_vertex.end(), 0u);
+        if (owned) {
+            vpos = std::move(owned->points);
+        } else {
+            vpos = soup.points;
+        }
+    } else {
+        const std::uint32_t num_exact = weld_exact(soup.points, point_vertex, vpos);
+        rep.exact_welded_points = num_points - num_exact;
+        if (owned) owned->points = {};  // from here on only vpos is read
+    }
 
     // Welded corners; in place of the input triangles when the soup is ours.
     std::vector<std::array<std::uint32_t, 3>> tri;
@@ -630,7 +571,7 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     report_progress("orient", 0.0);
     std::vector<std::uint8_t> flip(nf, 0);
     std::vector<std::uint32_t> comp(nf, kNone);
-    std::vector<std::uint32_t> comp_start;  // first facet (in BFS order) of each component
+    std::vector<std::uint32_t> comp_start;  // where each component starts in BFS order
     std::vector<std::uint32_t> bfs;
     bfs.reserve(nf);
     for (std::size_t seed = 0; seed < nf; ++seed) {
@@ -661,45 +602,51 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
             }
         }
     }
-    comp_start.push_back(static_cast<std::uint32_t>(bfs.size()));
-    const std::size_t num_comp = comp_start.size() - 1;
+    const std::size_t num_comp = comp_start.size();
+    bfs = {};
+    comp_start = {};
     if (options.orient) {
+        // Per-component sums in facet order (sequential memory access; BFS order scatters).
+        std::vector<std::uint64_t> size(num_comp, 0), flipped(num_comp, 0);
+        for (std::size_t f = 0; f < nf; ++f) {
+            ++size[comp[f]];
+            flipped[comp[f]] += flip[f];
+        }
         // Keep the majority's orientation: flip the minority of each component.
+        std::vector<std::uint8_t> invert(num_comp, 0);
         for (std::size_t c = 0; c < num_comp; ++c) {
-            const std::uint32_t b = comp_start[c], e = comp_start[c + 1];
-            std::size_t flipped = 0;
-            for (std::uint32_t q = b; q < e; ++q) flipped += flip[bfs[q]];
-            if (2 * flipped > e - b) {
-                for (std::uint32_t q = b; q < e; ++q) flip[bfs[q]] ^= 1;
-                flipped = (e - b) - flipped;
+            if (2 * flipped[c] > size[c]) {
+                invert[c] = 1;
+                flipped[c] = size[c] - flipped[c];
             }
-            rep.flipped_facets += flipped;
+            rep.flipped_facets += flipped[c];
         }
         // Turn closed components outward: positive signed volume (about the box center, for
         // precision).
         const Vec3 center = box.empty() ? Vec3{} : 0.5 * (box.min + box.max);
+        std::vector<double> volume6(num_comp, 0.0);
+        std::vector<std::uint8_t> open(num_comp, 0);
+        for (std::size_t f = 0; f < nf; ++f) {
+            const std::uint32_t c = comp[f];
+            flip[f] ^= invert[c];
+            open[c] |= mate[3 * f] == kNone || mate[3 * f + 1] == kNone || mate[3 * f + 2] == kNone;
+            const Vec3 p0 = vpos[corner[3 * f]] - center;
+            Vec3 p1 = vpos[corner[3 * f + 1]] - center;
+            Vec3 p2 = vpos[corner[3 * f + 2]] - center;
+            if (flip[f]) std::swap(p1, p2);
+            volume6[c] += dot(p0, cross(p1, p2));
+        }
+        std::vector<std::uint8_t> turn(num_comp, 0);
         for (std::size_t c = 0; c < num_comp; ++c) {
-            const std::uint32_t b = comp_start[c], e = comp_start[c + 1];
-            bool closed = true;
-            double volume6 = 0;
-            for (std::uint32_t q = b; q < e; ++q) {
-                const std::uint32_t f = bfs[q];
-                for (int k = 0; k < 3; ++k) closed &= mate[3 * f + k] != kNone;
-                const Vec3 p0 = vpos[corner[3 * f]] - center;
-                Vec3 p1 = vpos[corner[3 * f + 1]] - center;
-                Vec3 p2 = vpos[corner[3 * f + 2]] - center;
-                if (flip[f]) std::swap(p1, p2);
-                volume6 += dot(p0, cross(p1, p2));
-            }
-            if (closed && volume6 < 0) {
+            if (!open[c] && volume6[c] < 0) {
+                turn[c] = 1;
                 ++rep.components_turned_outward;
-                for (std::uint32_t q = b; q < e; ++q) flip[bfs[q]] ^= 1;
             }
         }
+        for (std::size_t f = 0; f < nf; ++f) flip[f] ^= turn[comp[f]];
     } else {
         std::fill(flip.begin(), flip.end(), 0);
     }
-    bfs = {};
     comp = {};
     report_progress("orient", 1.0);
 

@@ -50,7 +50,9 @@ Result<InfoReport> inspect_file(const std::filesystem::path& path, const HealOpt
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     if (progress) progress("read", 0.0);
-    auto soup = read_mesh_file(path);
+    ReadOptions read;
+    read.weld_exact = true;  // same mesh, a third of the memory
+    auto soup = read_mesh_file(path, read);
     if (!soup) return soup.error();
     if (progress) progress("read", 1.0);
     const auto t1 = Clock::now();
@@ -60,7 +62,7 @@ Result<InfoReport> inspect_file(const std::filesystem::path& path, const HealOpt
     r.unit = soup->unit;
     r.unit_assumed = soup->format != InputFormat::kSre;
     r.input_facets = soup->num_facets();
-    r.input_points = soup->points.size();
+    r.input_points = soup->points.size() + soup->welded_points;
     r.tools = soup->tools.size();
     r.surfaces = soup->surfaces.size();
     auto built = build_mesh(std::move(soup).value(), options, progress);
