@@ -18,5 +18,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } else if (r.error().message.empty()) {
         std::abort();
     }
+    // Welding while reading must accept exactly the same files and describe the same facets.
+    ncrev::ReadOptions weld;
+    weld.weld_exact = true;
+    auto w = ncrev::read_stl({reinterpret_cast<const std::byte*>(data), size}, "fuzz.stl", weld);
+    if (w.ok() != r.ok()) std::abort();
+    if (w.ok()) {
+        if (w->num_facets() != r->num_facets()) std::abort();
+        for (std::size_t f = 0; f < r->num_facets(); ++f) {
+            for (int k = 0; k < 3; ++k) {
+                const auto a = r->points[r->triangles[f][k]], b = w->points[w->triangles[f][k]];
+                if (!(a == b)) std::abort();  // -0 == +0
+            }
+        }
+    }
     return 0;
 }

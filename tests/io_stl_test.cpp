@@ -219,3 +219,46 @@ TEST(StlReader, ReadsFilesThroughThePathOverload) {
 
 }  // namespace
 }  // namespace ncrev
+
+namespace ncrev {
+namespace {
+
+TEST(StlReader, WeldsExactlyWhileReadingBinaryAndAscii) {
+    ReadOptions weld;
+    weld.weld_exact = true;
+    auto bin = read_stl(cube_binary(), {}, weld);
+    auto asc = read_stl(bytes_of(cube_ascii()), {}, weld);
+    for (auto* soup : {&bin, &asc}) {
+        ASSERT_TRUE(soup->ok());
+        EXPECT_TRUE((*soup)->points_distinct);
+        EXPECT_EQ((*soup)->points.size(), 8u);
+        EXPECT_EQ((*soup)->welded_points, 28u);
+        EXPECT_EQ((*soup)->num_facets(), 12u);
+    }
+    EXPECT_EQ(bin->points, asc->points);
+    EXPECT_EQ(bin->triangles, asc->triangles);
+    // The welded soup describes the same facets as the bucket.
+    auto bucket = read_stl(cube_binary());
+    ASSERT_TRUE(bucket.ok());
+    for (std::size_t f = 0; f < 12; ++f) {
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_EQ(bin->points[bin->triangles[f][k]], bucket->points[bucket->triangles[f][k]]);
+        }
+    }
+}
+
+TEST(StlReader, WeldingReaderTreatsNegativeZeroAsZeroAndKeepsErrors) {
+    auto c = test::cube();
+    c.points[0] = {-0.0, 0.0, -0.0};
+    ReadOptions weld;
+    weld.weld_exact = true;
+    auto bytes = encode_stl_binary(c.points, c.triangles);
+    auto soup = read_stl(bytes, {}, weld);
+    ASSERT_TRUE(soup.ok());
+    EXPECT_EQ(soup->points.size(), 8u);
+    bytes.resize(bytes.size() - 1);
+    EXPECT_EQ(read_stl(bytes, {}, weld).error().code, ErrorCode::kTruncated);
+}
+
+}  // namespace
+}  // namespace ncrev

@@ -327,3 +327,28 @@ TEST(MeshBuildDeterminism, SameMeshWhateverTheThreadCount) {
 
 }  // namespace
 }  // namespace ncrev
+
+namespace ncrev {
+namespace {
+
+TEST(MeshBuildInvariance, WeldingWhileReadingGivesTheSameMeshAndCounts) {
+    auto m = test::merge(test::icosphere(4.0, 3), test::cube({9, 0, 0}, 2.0));
+    m.triangles.push_back(m.triangles[5]);  // a duplicate
+    const auto bytes = encode_stl_binary(m.points, m.triangles);
+    ReadOptions weld;
+    weld.weld_exact = true;
+    auto a = read_stl(bytes);
+    auto b = read_stl(bytes, {}, weld);
+    ASSERT_TRUE(a.ok() && b.ok());
+    auto ma = build_ok(*a), mb = build_ok(std::move(b).value());
+    EXPECT_TRUE(std::ranges::equal(ma.mesh.origins(), mb.mesh.origins()));
+    EXPECT_TRUE(std::ranges::equal(ma.mesh.twins(), mb.mesh.twins()));
+    EXPECT_TRUE(std::ranges::equal(ma.mesh.positions(), mb.mesh.positions()));
+    EXPECT_EQ(ma.heal.input_points, mb.heal.input_points);
+    EXPECT_EQ(ma.heal.exact_welded_points, mb.heal.exact_welded_points);
+    EXPECT_EQ(ma.heal.duplicate_facets_removed, 1u);
+    EXPECT_EQ(mb.heal.duplicate_facets_removed, 1u);
+}
+
+}  // namespace
+}  // namespace ncrev
