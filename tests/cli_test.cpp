@@ -120,3 +120,49 @@ TEST(CliInfo, ReadsSreAndReportsItsUnit) {
 
 }  // namespace
 }  // namespace ncrev
+
+namespace ncrev {
+namespace {
+
+TEST(CliReverse, WritesAStepAndAReportAndRefusesToOverwriteItsInput) {
+    const auto c = test::cube({0, 0, 0}, 10.0);
+    const auto stl = write_temp("ncrev_cli_rev_cube.stl", encode_stl_binary(c.points, c.triangles));
+    const auto step = std::filesystem::temp_directory_path() / "ncrev_cli_rev_cube.step";
+    const auto report = std::filesystem::temp_directory_path() / "ncrev_cli_rev_cube.json";
+    std::filesystem::remove(step);
+    const CliRun r = run("reverse " + stl.string() + " -o " + step.string() +
+                         " --method planar --report " + report.string() + " --json -q");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["reverse"]["faces"], 6);
+    EXPECT_EQ(j["reverse"]["closed_valid_solid"], true);
+    EXPECT_TRUE(std::filesystem::exists(step));
+    std::ifstream in(report);
+    EXPECT_EQ(nlohmann::json::parse(in), j);
+    EXPECT_EQ(run("reverse " + stl.string() + " -o " + stl.string()).code, 1);
+    EXPECT_EQ(std::filesystem::file_size(stl), 84u + 50u * 12u);  // untouched
+    EXPECT_EQ(run("reverse " + stl.string() + " -o /nonexistent/dir/x.step -q").code, 4);
+    EXPECT_EQ(run("reverse " + stl.string() + " -o " + step.string() + " --method nurbs").code, 1);
+    std::filesystem::remove(step);
+    std::filesystem::remove(report);
+    std::filesystem::remove(stl);
+}
+
+TEST(CliReverse, OpenMeshWithRequireSolidExitsThreeAndWritesNothing) {
+    auto c = test::cube({0, 0, 0}, 10.0);
+    c.triangles.pop_back();
+    const auto stl = write_temp("ncrev_cli_rev_open.stl", encode_stl_binary(c.points, c.triangles));
+    const auto step = std::filesystem::temp_directory_path() / "ncrev_cli_rev_open.step";
+    std::filesystem::remove(step);
+    const CliRun r = run("reverse " + stl.string() + " -o " + step.string() + " --require-solid");
+    EXPECT_EQ(r.code, 3);
+    EXPECT_FALSE(std::filesystem::exists(step));
+    const CliRun shell = run("reverse " + stl.string() + " -o " + step.string());
+    EXPECT_EQ(shell.code, 0);
+    EXPECT_NE(shell.err.find("warning: the mesh is open"), std::string::npos) << shell.err;
+    std::filesystem::remove(step);
+    std::filesystem::remove(stl);
+}
+
+}  // namespace
+}  // namespace ncrev

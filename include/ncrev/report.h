@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "ncrev/brep.h"
 #include "ncrev/common.h"
 #include "ncrev/io.h"
 #include "ncrev/mesh.h"
@@ -27,12 +28,27 @@ struct InfoReport {
     std::vector<std::string> warnings;
 };
 
+/// A healed mesh and the report of how it was read and healed.
+struct HealedMesh {
+    Mesh mesh;
+    InfoReport report;
+};
+
+/// Reads and heals a mesh file (welding exactly while reading), keeping the mesh.
+Result<HealedMesh> read_and_heal(const std::filesystem::path& path, const HealOptions& options = {},
+                                 const ProgressFn& progress = {});
+
 /// Reads and heals a mesh file and gathers the numbers. Fails with the reader's error.
 Result<InfoReport> inspect_file(const std::filesystem::path& path, const HealOptions& options = {},
                                 const ProgressFn& progress = {});
 
 /// The report as one JSON object (keys: input, healing, mesh, timing, warnings).
 std::string to_json(const InfoReport& report, int indent = 2);
+
+/// The report of `ncrev reverse`: the info keys plus "reverse" (method, stages with seconds,
+/// faces by surface kind, faces, edges, vertices, solid, valid, volumes and areas of the mesh
+/// and of the solid, STEP bytes); warnings of both.
+std::string to_json(const InfoReport& info, const ReverseReport& reverse, int indent = 2);
 
 /// The report as a few lines of text for a terminal.
 std::string to_text(const InfoReport& report);

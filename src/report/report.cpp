@@ -47,6 +47,13 @@ std::vector<std::string> make_warnings(const InfoReport& r) {
 
 Result<InfoReport> inspect_file(const std::filesystem::path& path, const HealOptions& options,
                                 const ProgressFn& progress) {
+    auto healed = read_and_heal(path, options, progress);
+    if (!healed) return healed.error();
+    return std::move(healed->report);
+}
+
+Result<HealedMesh> read_and_heal(const std::filesystem::path& path, const HealOptions& options,
+                                 const ProgressFn& progress) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     if (progress) progress("read", 0.0);
@@ -77,10 +84,12 @@ Result<InfoReport> inspect_file(const std::filesystem::path& path, const HealOpt
     r.read_seconds = std::chrono::duration<double>(t1 - t0).count();
     r.build_seconds = std::chrono::duration<double>(t2 - t1).count();
     r.warnings = make_warnings(r);
-    return r;
+    return HealedMesh{std::move(built->mesh), std::move(r)};
 }
 
-std::string to_json(const InfoReport& r, int indent) {
+namespace {
+
+nlohmann::json info_json(const InfoReport& r) {
     using nlohmann::json;
     auto vec = [](Vec3 v) { return json::array({v.x, v.y, v.z}); };
     json j;
@@ -124,6 +133,38 @@ std::string to_json(const InfoReport& r, int indent) {
                  {"bbox", bbox}};
     j["timing"] = {{"read_seconds", r.read_seconds}, {"build_seconds", r.build_seconds}};
     j["warnings"] = r.warnings;
+    return j;
+}
+
+}  // namespace
+
+std::string to_json(const InfoReport& r, int indent) { return info_json(r).dump(indent); }
+
+std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent) {
+    using nlohmann::json;
+    json j = info_json(info);
+    json stages = json::array();
+    for (const auto& [name, seconds] : rev.stage_seconds) {
+        stages.push_back({{"name", name}, {"seconds", seconds}});
+    }
+    j["reverse"] = {{"method", to_string(rev.method)},
+                    {"stages", stages},
+                    {"planar_tolerance", rev.planar_tolerance},
+                    {"planar_tolerance_rule", rev.planar_tolerance_rule},
+                    {"faces_by_kind", rev.faces_by_kind},
+                    {"faces", rev.faces},
+                    {"edges", rev.edges},
+                    {"vertices", rev.vertices},
+                    {"solid", rev.solid},
+                    {"valid", rev.valid},
+                    {"closed_valid_solid", rev.solid && rev.valid},
+                    {"mesh_volume", rev.mesh_volume},
+                    {"mesh_area", rev.mesh_area},
+                    {"solid_volume", rev.solid_volume},
+                    {"solid_area", rev.solid_area},
+                    {"written", rev.written},
+                    {"step_bytes", rev.step_bytes}};
+    for (const std::string& w : rev.warnings) j["warnings"].push_back(w);
     return j.dump(indent);
 }
 

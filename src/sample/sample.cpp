@@ -2,7 +2,6 @@
 // STEP); write_sample_part(): the five files, each written atomically.
 #include <unistd.h>
 
-#include <APIHeaderSection_MakeHeader.hxx>
 #include <BRepBndLib.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepGProp.hxx>
@@ -10,25 +9,16 @@
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
 #include <GProp_GProps.hxx>
-#include <Interface_Static.hxx>
-#include <Message.hxx>
-#include <Message_Messenger.hxx>
-#include <Message_PrinterOStream.hxx>
-#include <STEPControl_Controller.hxx>
-#include <STEPControl_Writer.hxx>
 #include <Standard_Failure.hxx>
-#include <StepBasic_Product.hxx>
-#include <StepData_StepModel.hxx>
-#include <TCollection_HAsciiString.hxx>
 #include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
 #include <atomic>
 #include <fstream>
-#include <mutex>
 #include <sstream>
 
+#include "brep/step.h"
 #include "ncrev/io.h"
 #include "sample/sample_internal.h"
 
@@ -38,9 +28,6 @@ namespace sd = sample_detail;
 using Json = nlohmann::ordered_json;
 
 namespace {
-
-// The STEP header's time stamp: fixed, so that the same part gives byte-identical files.
-constexpr const char* kStepTimeStamp = "2000-01-01T00:00:00";
 
 Error make_error(ErrorCode code, std::string message) {
     Error e;
@@ -154,37 +141,9 @@ std::string truth_document(const SamplePart& part, std::string_view description,
 
 namespace sample_detail {
 
-void silence_occt() {
-    static std::once_flag once;
-    std::call_once(once, [] {
-        const Handle(Message_Messenger)& m = Message::DefaultMessenger();
-        m->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
-    });
-}
+void silence_occt() { brep_detail::silence_occt(); }
 
 std::string step_text(const TopoDS_Shape& solid, std::string_view part_name) {
-    static std::mutex step_mutex;  // Interface_Static is process-wide state
-    const std::lock_guard<std::mutex> lock(step_mutex);
-    STEPControl_Controller::Init();
-    Interface_Static::SetCVal("write.step.schema", "AP214IS");
-    Interface_Static::SetCVal("write.step.unit", "MM");
-    const std::string name(part_name);
-    STEPControl_Writer writer;
-    if (writer.Transfer(solid, STEPControl_AsIs) != IFSelect_RetDone) return {};
-    const Handle(StepData_StepModel) model = writer.Model();
-    APIHeaderSection_MakeHeader header(model);
-    const Handle(TCollection_HAsciiString) hname = new TCollection_HAsciiString(name.c_str());
-    header.SetName(hname);
-    header.SetTimeStamp(new TCollection_HAsciiString(kStepTimeStamp));
-    // OCCT names the product "<name> <process-wide counter>": name it after the part alone.
-    for (int i = 1; i <= model->NbEntities(); ++i) {
-        const Handle(StepBasic_Product) product =
-            Handle(StepBasic_Product)::DownCast(model->Value(i));
-        if (product.IsNull()) continue;
-        product->SetId(hname);
-        product->SetName(hname);
-    }
-
     // OCCT writes STEP only to a file: a private temporary one, read back and removed.
     static std::atomic<unsigned> counter{0};
     std::error_code ec;
@@ -192,8 +151,10 @@ std::string step_text(const TopoDS_Shape& solid, std::string_view part_name) {
         std::filesystem::temp_directory_path(ec) /
         ("ncrev-sample-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ".step");
     if (ec) return {};
+    brep_detail::StepWriteOptions options;
+    options.product_name = std::string(part_name);
     std::string text;
-    if (writer.Write(tmp.c_str()) == IFSelect_RetDone) {
+    if (brep_detail::write_step_file(solid, tmp, options).ok()) {
         std::ifstream in(tmp, std::ios::binary);
         std::ostringstream ss;
         ss << in.rdbuf();

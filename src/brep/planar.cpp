@@ -1,0 +1,359 @@
+// Planar B-rep from a half-edge mesh (../shared/docs/method.md, Step 2a, and "Beyond the paper":
+// coplanar merging). One code path serves both methods: `facets` is planar merging with every
+// facet its own region.
+//
+// 1. Regions: facets grown breadth-first from a seed while every vertex of the candidate lies
+//    within the tolerance of the seed's plane (facets: one region per facet).
+// 2. Borders: mesh edges between two regions, or on the mesh boundary. Corners: vertices where
+//    borders branch, where the pair of regions changes, or where the border turns. Each border
+//    chain between corners is then split wherever a straight segment would leave the
+//    tolerance, so that its segments are the B-rep's edges — computed once per chain, so the
+//    two faces on either side share exactly the same edges and vertices.
+// 3. Faces: each region's border half-edges walked into loops, compressed to oriented segment
+//    edges; the loop of largest signed area is the outer wire, the others are holes.
+// Everything is made with BRep_Builder: shared vertices and edges, no sewing.
+#include "brep/planar.h"
+
+#include <BRepLib.hxx>
+#include <BRep_Builder.hxx>
+#include <Geom_Line.hxx>
+#include <Geom_Plane.hxx>
+#include <Precision.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Shell.hxx>
+#include <TopoDS_Solid.hxx>
+#include <TopoDS_Vertex.hxx>
+#include <TopoDS_Wire.hxx>
+#include <algorithm>
+#include <cmath>
+
+namespace ncrev::brep_detail {
+
+namespace {
+
+constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+
+gp_Pnt pnt(Vec3 v) { return {v.x, v.y, v.z}; }
+
+double distance_to_segment(Vec3 p, Vec3 a, Vec3 b) {
+    const Vec3 ab = b - a;
+    const double len2 = dot(ab, ab);
+    if (len2 == 0) return norm(p - a);
+    const double t = std::clamp(dot(p - a, ab) / len2, 0.0, 1.0);
+    return norm(p - (a + t * ab));
+}
+
+}  // namespace
+
+PlanarBuild build_planar_shape(const Mesh& m, bool merge, double tol) {
+    const std::size_t nf = m.num_faces(), nh = m.num_halfedges(), nv = m.num_vertices();
+    PlanarBuild out;
+
+    // 1. Regions.
+    std::vector<std::uint32_t> region(nf, kNone);
+    std::vector<std::uint32_t> queue;
+    std::uint32_t num_regions = 0;
+    for (std::size_t seed = 0; seed < nf; ++seed) {
+        if (region[seed] != kNone) continue;
+        const std::uint32_t r = num_regions++;
+        region[seed] = r;
+        if (!merge) continue;
+        const FaceId sf(static_cast<std::uint32_t>(seed));
+        const Vec3 n = m.face_normal(sf);
+        const Vec3 p0 = m.position(m.vertex(sf, 0));
+        queue.assign(1, static_cast<std::uint32_t>(seed));
+        for (std::size_t q = 0; q < queue.size(); ++q) {
+            const std::uint32_t f = queue[q];
+            for (int k = 0; k < 3; ++k) {
+                const HalfedgeId t = m.twin(Mesh::halfedge(FaceId(f), k));
+                if (!t.is_valid()) continue;
+                const FaceId g = Mesh::face(t);
+                if (region[g.idx()] != kNone) continue;
+                if (dot(m.face_normal_area2(g), n) <= 0) continue;
+                bool on_plane = true;
+                for (int j = 0; j < 3 && on_plane; ++j) {
+                    on_plane = std::abs(dot(m.position(m.vertex(g, j)) - p0, n)) <= tol;
+                }
+                if (!on_plane) continue;
+                region[g.idx()] = r;
+                queue.push_back(g.idx());
+            }
+        }
+    }
+
+    // Region planes: area-weighted normal through the area-weighted centroid.
+    std::vector<Vec3> rn(num_regions), rc(num_regions);
+    std::vector<double> ra(num_regions, 0.0);
+    for (std::size_t f = 0; f < nf; ++f) {
+        const FaceId ff(static_cast<std::uint32_t>(f));
+        const Vec3 n2 = m.face_normal_area2(ff);
+        const double a = 0.5 * norm(n2);
+        const Vec3 c = (m.position(m.vertex(ff, 0)) + m.position(m.vertex(ff, 1)) +
+                        m.position(m.vertex(ff, 2))) /
+                       3.0;
+        rn[region[f]] += n2;
+        rc[region[f]] += a * c;
+        ra[region[f]] += a;
+    }
+    double deviation = 0;
+    for (std::uint32_t r = 0; r < num_regions; ++r) {
+        rn[r] = normalized(rn[r]);
+        rc[r] = ra[r] > 0 ? rc[r] / ra[r] : rc[r];
+    }
+    for (std::size_t f = 0; f < nf; ++f) {
+        const FaceId ff(static_cast<std::uint32_t>(f));
+        for (int k = 0; k < 3; ++k) {
+            const double d =
+                std::abs(dot(m.position(m.vertex(ff, k)) - rc[region[f]], rn[region[f]]));
+            deviation = std::max(deviation, d);
+        }
+    }
+
+    // 2. Borders and corners. A border half-edge has no twin or a twin in another region.
+    auto is_border = [&](HalfedgeId h) {
+        const HalfedgeId t = m.twin(h);
+        return !t.is_valid() || region[Mesh::face(t).idx()] != region[Mesh::face(h).idx()];
+    };
+    auto pair_key = [&](HalfedgeId h) {
+        const std::uint64_t a = region[Mesh::face(h).idx()];
+        const HalfedgeId t = m.twin(h);
+        const std::uint64_t b = t.is_valid() ? region[Mesh::face(t).idx()] : kNone;
+        return a < b ? (a << 32) | b : (b << 32) | a;
+    };
+    // Per vertex: border degree and the two border neighbours (as canonical half-edges).
+    std::vector<std::uint8_t> degree(nv, 0);
+    std::vector<std::array<std::uint32_t, 2>> incident(nv, {kNone, kNone});
+    auto canonical = [&](HalfedgeId h) {
+        const HalfedgeId t = m.twin(h);
+        return (!t.is_valid() || h.idx() < t.idx()) ? h : t;
+    };
+    for (std::size_t hi = 0; hi < nh; ++hi) {
+        const HalfedgeId h(static_cast<std::uint32_t>(hi));
+        if (!is_border(h) || canonical(h) != h) continue;
+        for (VertexId v : {m.origin(h), m.target(h)}) {
+            const std::uint8_t d = degree[v.idx()];
+            if (d < 2) incident[v.idx()][d] = h.idx();
+            degree[v.idx()] = static_cast<std::uint8_t>(std::min(3, d + 1));
+        }
+    }
+    auto other_end = [&](std::uint32_t e, VertexId v) {
+        const HalfedgeId h(e);
+        return m.origin(h) == v ? m.target(h) : m.origin(h);
+    };
+    std::vector<std::uint8_t> corner(nv, 0);
+    for (std::size_t v = 0; v < nv; ++v) {
+        if (degree[v] == 0) continue;
+        if (degree[v] != 2) {
+            corner[v] = 1;
+            continue;
+        }
+        const std::uint32_t e0 = incident[v][0], e1 = incident[v][1];
+        if (pair_key(HalfedgeId(e0)) != pair_key(HalfedgeId(e1))) {
+            corner[v] = 1;
+            continue;
+        }
+        const VertexId vv(static_cast<std::uint32_t>(v));
+        const Vec3 a = m.position(other_end(e0, vv)), b = m.position(other_end(e1, vv));
+        if (!merge || distance_to_segment(m.position(vv), a, b) > tol) corner[v] = 1;
+    }
+
+    // Chains: from each corner along each of its border edges to the next corner, split into
+    // straight segments within the tolerance. seg_of[canonical half-edge] = segment,
+    // seg_from[segment] = its first vertex.
+    std::vector<std::uint32_t> seg_of(nh, kNone);
+    std::vector<std::array<std::uint32_t, 2>> seg_ends;
+    std::vector<std::uint32_t> chain_v, chain_e;
+    auto walk_chain = [&](VertexId start, std::uint32_t first_edge) {
+        chain_v.assign(1, start.idx());
+        chain_e.clear();
+        VertexId v = start;
+        std::uint32_t e = first_edge;
+        for (std::size_t guard = 0; guard <= nh; ++guard) {
+            chain_e.push_back(e);
+            v = other_end(e, v);
+            chain_v.push_back(v.idx());
+            if (corner[v.idx()] || v == start) break;
+            e = incident[v.idx()][0] == e ? incident[v.idx()][1] : incident[v.idx()][0];
+        }
+        // Greedy straight segments: extend while every inner vertex stays within tol.
+        std::size_t s = 0;
+        while (s + 1 < chain_v.size()) {
+            std::size_t t = s + 1;
+            while (merge && t + 1 < chain_v.size()) {
+                const Vec3 a = m.position(VertexId(chain_v[s]));
+                const Vec3 b = m.position(VertexId(chain_v[t + 1]));
+                bool straight = true;
+                for (std::size_t i = s + 1; i <= t && straight; ++i) {
+                    straight = distance_to_segment(m.position(VertexId(chain_v[i])), a, b) <= tol;
+                }
+                if (!straight) break;
+                ++t;
+            }
+            const auto seg = static_cast<std::uint32_t>(seg_ends.size());
+            seg_ends.push_back({chain_v[s], chain_v[t]});
+            for (std::size_t i = s; i < t; ++i) seg_of[chain_e[i]] = seg;
+            s = t;
+        }
+    };
+    // Every border edge not yet in a segment: go back to the corner its chain starts at, then
+    // walk the chain forward (a corner of degree > 2 is left once per chain this way).
+    for (std::size_t hi = 0; hi < nh; ++hi) {
+        const HalfedgeId h(static_cast<std::uint32_t>(hi));
+        if (!is_border(h) || canonical(h) != h || seg_of[hi] != kNone) continue;
+        VertexId v = m.origin(h);
+        std::uint32_t e = h.idx();
+        bool corner_free_loop = false;
+        for (std::size_t guard = 0; guard <= nh && !corner[v.idx()]; ++guard) {
+            const std::uint32_t back =
+                incident[v.idx()][0] == e ? incident[v.idx()][1] : incident[v.idx()][0];
+            if (back == h.idx()) {
+                corner_free_loop = true;
+                break;
+            }
+            v = other_end(back, v);
+            e = back;
+        }
+        if (corner_free_loop) {  // a closed border with no corner: start it anywhere
+            v = m.origin(h);
+            e = h.idx();
+            corner[v.idx()] = 1;
+        }
+        walk_chain(v, e);
+    }
+
+    // 3. Vertices and edges of the B-rep.
+    const double shape_tol =
+        std::max(Precision::Confusion(), 1.001 * std::max(deviation, merge ? tol : 0.0));
+    out.tolerance = shape_tol;
+    BRep_Builder builder;
+    std::vector<TopoDS_Vertex> vertex(nv);
+    auto vertex_of = [&](std::uint32_t v) -> const TopoDS_Vertex& {
+        if (vertex[v].IsNull()) {
+            builder.MakeVertex(vertex[v], pnt(m.position(VertexId(v))), shape_tol);
+            ++out.vertices;
+        }
+        return vertex[v];
+    };
+    std::vector<TopoDS_Edge> edge(seg_ends.size());
+    for (std::size_t s = 0; s < seg_ends.size(); ++s) {
+        const Vec3 a = m.position(VertexId(seg_ends[s][0])),
+                   b = m.position(VertexId(seg_ends[s][1]));
+        const double len = norm(b - a);
+        Handle(Geom_Line) line = new Geom_Line(pnt(a), gp_Dir(b.x - a.x, b.y - a.y, b.z - a.z));
+        builder.MakeEdge(edge[s], line, shape_tol);
+        builder.Add(edge[s], vertex_of(seg_ends[s][0]).Oriented(TopAbs_FORWARD));
+        builder.Add(edge[s], vertex_of(seg_ends[s][1]).Oriented(TopAbs_REVERSED));
+        builder.Range(edge[s], 0.0, len);
+    }
+    out.edges = seg_ends.size();
+
+    // 4. Faces: loops of border half-edges per region.
+    std::vector<std::uint8_t> walked(nh, 0);
+    TopoDS_Shell shell;
+    builder.MakeShell(shell);
+    // Border half-edges grouped by region, in half-edge order.
+    std::vector<std::uint32_t> start(num_regions + 1, 0), border;
+    for (std::size_t hi = 0; hi < nh; ++hi) {
+        if (is_border(HalfedgeId(static_cast<std::uint32_t>(hi)))) ++start[region[hi / 3] + 1];
+    }
+    for (std::uint32_t r = 0; r < num_regions; ++r) start[r + 1] += start[r];
+    border.resize(start[num_regions]);
+    {
+        std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+        for (std::size_t hi = 0; hi < nh; ++hi) {
+            if (is_border(HalfedgeId(static_cast<std::uint32_t>(hi)))) {
+                border[fill[region[hi / 3]]++] = static_cast<std::uint32_t>(hi);
+            }
+        }
+    }
+    struct Loop {
+        std::vector<std::pair<std::uint32_t, bool>> edges;  // (segment, forward)
+        double area = 0;
+    };
+    std::vector<Loop> loops;
+    std::vector<std::uint32_t> loop_h;
+    for (std::uint32_t r = 0; r < num_regions; ++r) {
+        loops.clear();
+        for (std::uint32_t k = start[r]; k < start[r + 1]; ++k) {
+            if (walked[border[k]]) continue;
+            loop_h.clear();
+            HalfedgeId h(border[k]);
+            for (std::size_t guard = 0; guard <= nh && !walked[h.idx()]; ++guard) {
+                walked[h.idx()] = 1;
+                loop_h.push_back(h.idx());
+                HalfedgeId g = Mesh::next(h);
+                for (std::size_t g2 = 0; g2 <= nh && !is_border(g); ++g2) g = Mesh::next(m.twin(g));
+                h = g;
+            }
+            // Rotate so that the loop starts at a segment's end, then compress.
+            std::size_t first = 0;
+            for (std::size_t i = 0; i < loop_h.size(); ++i) {
+                const HalfedgeId hh(loop_h[i]);
+                const std::uint32_t seg = seg_of[canonical(hh).idx()];
+                const VertexId o = m.origin(hh);
+                if (seg_ends[seg][0] == o.idx() || seg_ends[seg][1] == o.idx()) {
+                    first = i;
+                    break;
+                }
+            }
+            Loop loop;
+            Vec3 area2{};
+            const Vec3 o = rc[r];
+            for (std::size_t i = 0; i < loop_h.size(); ++i) {
+                const HalfedgeId hh(loop_h[(first + i) % loop_h.size()]);
+                const Vec3 a = m.position(m.origin(hh)) - o, b = m.position(m.target(hh)) - o;
+                area2 += cross(a, b);
+                const std::uint32_t seg = seg_of[canonical(hh).idx()];
+                if (!loop.edges.empty() && loop.edges.back().first == seg) continue;
+                // The segment runs seg_ends[0] -> [1] (straight within tol): hh runs along it
+                // when its origin is nearer to the segment's start than its target.
+                const Vec3 s0 = m.position(VertexId(seg_ends[seg][0]));
+                const bool forward =
+                    norm(m.position(m.origin(hh)) - s0) < norm(m.position(m.target(hh)) - s0);
+                loop.edges.emplace_back(seg, forward);
+            }
+            loop.area = 0.5 * dot(area2, rn[r]);
+            loops.push_back(std::move(loop));
+        }
+        if (loops.empty()) continue;
+        std::size_t outer = 0;
+        for (std::size_t i = 1; i < loops.size(); ++i) {
+            if (loops[i].area > loops[outer].area) outer = i;
+        }
+        Handle(Geom_Plane) plane = new Geom_Plane(pnt(rc[r]), gp_Dir(rn[r].x, rn[r].y, rn[r].z));
+        TopoDS_Face face;
+        builder.MakeFace(face, plane, shape_tol);
+        for (std::size_t li = 0; li < loops.size(); ++li) {
+            const Loop& loop = loops[li == 0 ? outer : (li <= outer ? li - 1 : li)];
+            TopoDS_Wire wire;
+            builder.MakeWire(wire);
+            for (const auto& [seg, fwd] : loop.edges) {
+                builder.Add(wire, edge[seg].Oriented(fwd ? TopAbs_FORWARD : TopAbs_REVERSED));
+            }
+            wire.Closed(true);
+            builder.Add(face, wire);
+        }
+        builder.Add(shell, face);
+        ++out.faces;
+    }
+
+    bool closed = nf > 0;
+    for (std::size_t hi = 0; hi < nh && closed; ++hi) {
+        closed = !m.is_boundary(HalfedgeId(static_cast<std::uint32_t>(hi)));
+    }
+    shell.Closed(closed);
+    if (closed) {
+        TopoDS_Solid solid;
+        builder.MakeSolid(solid);
+        builder.Add(solid, shell);
+        out.shape = solid;
+        out.solid = true;
+    } else {
+        out.shape = shell;
+    }
+    return out;
+}
+
+}  // namespace ncrev::brep_detail

@@ -1,0 +1,10 @@
+# The brep module: OpenCASCADE B-rep construction and STEP writing.
+list(APPEND NCREV_OCCT_SOURCES
+    ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/planar.cpp
+    ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/reverse.cpp
+    ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/step.cpp
+)
+list(APPEND NCREV_OCCT_LIBS
+    TKernel TKMath TKG2d TKG3d TKGeomBase TKBRep TKGeomAlgo TKTopAlgo TKShHealing
+    TKXSBase TKSTEPBase TKSTEPAttr TKSTEP209 TKSTEP
+)

@@ -1,0 +1,115 @@
+#include "brep/step.h"
+
+#include <unistd.h>
+
+#include <APIHeaderSection_MakeHeader.hxx>
+#include <Interface_Static.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <Message_PrinterOStream.hxx>
+#include <STEPControl_Controller.hxx>
+#include <STEPControl_Writer.hxx>
+#include <Standard_Failure.hxx>
+#include <StepBasic_Product.hxx>
+#include <StepData_StepModel.hxx>
+#include <TCollection_HAsciiString.hxx>
+#include <atomic>
+#include <mutex>
+
+namespace ncrev::brep_detail {
+
+void silence_occt() {
+    static std::once_flag once;
+    std::call_once(once, [] {
+        const Handle(Message_Messenger)& m = Message::DefaultMessenger();
+        m->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
+    });
+}
+
+namespace {
+
+const char* schema_name(StepSchema s) {
+    switch (s) {
+        case StepSchema::kAP203:
+            return "AP203";
+        case StepSchema::kAP242:
+            return "AP242DIS";
+        case StepSchema::kAP214:
+            break;
+    }
+    return "AP214IS";
+}
+
+Error write_error(ErrorCode code, const std::filesystem::path& path, std::string message) {
+    Error e;
+    e.code = code;
+    e.path = path.string();
+    e.message = std::move(message);
+    return e;
+}
+
+}  // namespace
+
+Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& path,
+                       const StepWriteOptions& options) {
+    silence_occt();
+    static std::mutex step_mutex;  // Interface_Static is process-wide state
+    const std::lock_guard<std::mutex> lock(step_mutex);
+    static std::atomic<unsigned> counter{0};
+    const std::filesystem::path dir =
+        path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+    std::string tmp_name = ".";
+    tmp_name.append(path.filename().string())
+        .append(".tmp")
+        .append(std::to_string(::getpid()))
+        .append("-")
+        .append(std::to_string(counter++));
+    const std::filesystem::path tmp = dir / tmp_name;
+    try {
+        STEPControl_Controller::Init();
+        Interface_Static::SetCVal("write.step.schema", schema_name(options.schema));
+        Interface_Static::SetCVal("write.step.unit", options.unit == Unit::kInch ? "INCH" : "MM");
+        STEPControl_Writer writer;
+        if (writer.Transfer(shape, STEPControl_AsIs) != IFSelect_RetDone) {
+            return write_error(ErrorCode::kBadValue, path,
+                               "OpenCASCADE could not transfer the shape to STEP");
+        }
+        const Handle(StepData_StepModel) model = writer.Model();
+        APIHeaderSection_MakeHeader header(model);
+        const Handle(TCollection_HAsciiString) name =
+            new TCollection_HAsciiString(options.product_name.c_str());
+        header.SetName(name);
+        if (!options.timestamp.empty()) {
+            header.SetTimeStamp(new TCollection_HAsciiString(options.timestamp.c_str()));
+        }
+        // OCCT names the product "<name> <process-wide counter>": use the name alone.
+        for (int i = 1; i <= model->NbEntities(); ++i) {
+            const Handle(StepBasic_Product) product =
+                Handle(StepBasic_Product)::DownCast(model->Value(i));
+            if (product.IsNull()) continue;
+            product->SetId(name);
+            product->SetName(name);
+        }
+        if (writer.Write(tmp.c_str()) != IFSelect_RetDone) {
+            std::error_code ec;
+            std::filesystem::remove(tmp, ec);
+            return write_error(ErrorCode::kCannotWrite, path,
+                               "cannot write a STEP file in " + dir.string());
+        }
+    } catch (const Standard_Failure& f) {
+        std::error_code ec;
+        std::filesystem::remove(tmp, ec);
+        return write_error(ErrorCode::kBadValue, path,
+                           std::string("OpenCASCADE failed writing STEP: ") + f.GetMessageString());
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        std::filesystem::remove(tmp, ec);
+        return write_error(ErrorCode::kCannotWrite, path,
+                           "cannot rename into place: " + ec.message());
+    }
+    return Ok{};
+}
+
+}  // namespace ncrev::brep_detail

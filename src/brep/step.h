@@ -1,0 +1,33 @@
+// Writing OpenCASCADE shapes as STEP files: schema, unit, product name, a silent messenger and
+// an atomic write. Internal to the library (OpenCASCADE types allowed).
+#pragma once
+
+#include <TopoDS_Shape.hxx>
+#include <filesystem>
+#include <string>
+
+#include "ncrev/brep.h"
+#include "ncrev/common.h"
+
+namespace ncrev::brep_detail {
+
+/// Removes OpenCASCADE's default stdout printer once per process: stdout belongs to the user
+/// (and to `--json`), and OCCT prints transfer statistics there by default.
+void silence_occt();
+
+struct StepWriteOptions {
+    StepSchema schema = StepSchema::kAP214;
+    Unit unit = Unit::kMillimetre;
+    std::string product_name = "ncrev";
+    /// Header time stamp. Fixed by default so that the same input gives byte-identical STEP
+    /// (the house rule on determinism); empty: the current time.
+    std::string timestamp = "2000-01-01T00:00:00";
+};
+
+/// Writes `shape` to `path` atomically (a temporary file in the same folder, then a rename).
+/// kBadValue when OpenCASCADE cannot transfer the shape, kCannotWrite when the file cannot
+/// be written. Serialised: OpenCASCADE's STEP settings are process-wide.
+Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& path,
+                       const StepWriteOptions& options);
+
+}  // namespace ncrev::brep_detail

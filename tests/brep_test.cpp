@@ -1,0 +1,217 @@
+// Issue 4: one surface per triangle and planar merging. Every STEP is read back with
+// STEPControl_Reader and checked with BRepCheck_Analyzer; volumes are compared with the mesh's.
+#include "ncrev/brep.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <BRepAlgoAPI_Cut.hxx>
+#include <BRepAlgoAPI_Fuse.hxx>
+#include <BRepCheck_Analyzer.hxx>
+#include <BRepGProp.hxx>
+#include <BRepMesh_IncrementalMesh.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRep_Tool.hxx>
+#include <GProp_GProps.hxx>
+#include <Poly_Triangulation.hxx>
+#include <STEPControl_Reader.hxx>
+#include <ShapeUpgrade_UnifySameDomain.hxx>
+#include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <fstream>
+
+#include "ncrev/sample.h"
+#include "test_meshes.h"
+
+namespace ncrev {
+namespace {
+
+/// The shape's BRepMesh triangulation as a facet bucket, facets outward.
+TriangleSoup tessellate(const TopoDS_Shape& shape, double deflection) {
+    BRepMesh_IncrementalMesh mesher(shape, deflection, false, 0.5, false);
+    TriangleSoup soup;
+    for (TopExp_Explorer ex(shape, TopAbs_FACE); ex.More(); ex.Next()) {
+        const TopoDS_Face face = TopoDS::Face(ex.Current());
+        TopLoc_Location loc;
+        const Handle(Poly_Triangulation) tri = BRep_Tool::Triangulation(face, loc);
+        if (tri.IsNull()) continue;
+        const bool reversed = face.Orientation() == TopAbs_REVERSED;
+        for (int t = 1; t <= tri->NbTriangles(); ++t) {
+            int n[3];
+            tri->Triangle(t).Get(n[0], n[1], n[2]);
+            if (reversed) std::swap(n[1], n[2]);
+            const auto base = static_cast<std::uint32_t>(soup.points.size());
+            for (int k = 0; k < 3; ++k) {
+                const gp_Pnt p = tri->Node(n[k]).Transformed(loc.Transformation());
+                soup.points.push_back({p.X(), p.Y(), p.Z()});
+            }
+            soup.triangles.push_back({base, base + 1, base + 2});
+        }
+    }
+    return soup;
+}
+
+std::size_t count_faces(const TopoDS_Shape& s) {
+    TopTools_IndexedMapOfShape faces;
+    TopExp::MapShapes(s, TopAbs_FACE, faces);
+    return static_cast<std::size_t>(faces.Extent());
+}
+
+struct ReadBack {
+    TopoDS_Shape shape;
+    bool valid = false;
+    std::size_t solids = 0, faces = 0;
+    double volume = 0;
+};
+
+ReadBack read_step(const std::filesystem::path& path) {
+    ReadBack r;
+    STEPControl_Reader reader;
+    if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) return r;
+    reader.TransferRoots();
+    r.shape = reader.OneShape();
+    r.valid = BRepCheck_Analyzer(r.shape).IsValid();
+    TopTools_IndexedMapOfShape solids;
+    TopExp::MapShapes(r.shape, TopAbs_SOLID, solids);
+    r.solids = static_cast<std::size_t>(solids.Extent());
+    r.faces = count_faces(r.shape);
+    GProp_GProps props;
+    BRepGProp::VolumeProperties(r.shape, props);
+    r.volume = props.Mass();
+    return r;
+}
+
+std::filesystem::path out_dir() {
+    static const auto dir = [] {
+        auto d = std::filesystem::temp_directory_path() /
+                 ("ncrev_brep_test_" + std::to_string(::getpid()));
+        std::filesystem::create_directories(d);
+        return d;
+    }();
+    return dir;
+}
+
+Mesh heal(TriangleSoup soup) {
+    auto built = build_mesh(std::move(soup));
+    EXPECT_TRUE(built.ok());
+    return std::move(built->mesh);
+}
+
+/// Builds with `method`, writes, reads back, checks validity, closure and volume.
+ReadBack round_trip(const Mesh& mesh, ReverseMethod method, const std::string& name,
+                    double volume_rel) {
+    ReverseOptions o;
+    o.method = method;
+    const auto path = out_dir() / (name + "_" + to_string(method) + ".step");
+    auto rev = reverse_to_step(mesh, path, o);
+    EXPECT_TRUE(rev.ok()) << (rev.ok() ? "" : rev.error().describe());
+    if (!rev.ok()) return {};
+    EXPECT_TRUE(rev->valid) << name;
+    EXPECT_TRUE(rev->solid) << name;
+    EXPECT_TRUE(rev->written) << name;
+    EXPECT_NEAR(rev->solid_volume, rev->mesh_volume, volume_rel * rev->mesh_volume) << name;
+    ReadBack back = read_step(path);
+    EXPECT_TRUE(back.valid) << name;
+    EXPECT_EQ(back.solids, 1u) << name;
+    EXPECT_EQ(back.faces, rev->faces) << name;
+    EXPECT_NEAR(back.volume, rev->mesh_volume, volume_rel * rev->mesh_volume) << name;
+    return back;
+}
+
+TopoDS_Shape unify(const TopoDS_Shape& s) {
+    ShapeUpgrade_UnifySameDomain u(s, true, true, true);
+    u.Build();
+    return u.Shape();
+}
+
+struct PlanarPart {
+    std::string name;
+    TopoDS_Shape shape;
+};
+
+std::vector<PlanarPart> planar_parts() {
+    std::vector<PlanarPart> parts;
+    const TopoDS_Shape block = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 40, 30, 20).Shape();
+    // A through rectangular hole: top and bottom faces get an inner wire.
+    const TopoDS_Shape hole = BRepPrimAPI_MakeBox(gp_Pnt(12, 9, -1), 10, 8, 22).Shape();
+    parts.push_back({"through_hole", unify(BRepAlgoAPI_Cut(block, hole).Shape())});
+    // A blind pocket.
+    const TopoDS_Shape pocket = BRepPrimAPI_MakeBox(gp_Pnt(5, 5, 12), 20, 12, 9).Shape();
+    parts.push_back({"pocket", unify(BRepAlgoAPI_Cut(block, pocket).Shape())});
+    // An L-bracket: two fused boxes, coplanar faces unified.
+    const TopoDS_Shape leg = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 20), 8, 30, 25).Shape();
+    parts.push_back({"l_block", unify(BRepAlgoAPI_Fuse(block, leg).Shape())});
+    return parts;
+}
+
+TEST(ReversePlanar, PrismaticPartsComeBackWithTheirTrueFaces) {
+    for (const PlanarPart& p : planar_parts()) {
+        const Mesh mesh = heal(tessellate(p.shape, 0.1));
+        ASSERT_TRUE(compute_stats(mesh).closed) << p.name;
+        const ReadBack back = round_trip(mesh, ReverseMethod::kPlanar, p.name, 1e-7);
+        EXPECT_EQ(back.faces, count_faces(p.shape)) << p.name;
+    }
+}
+
+TEST(ReverseFacets, OneFacePerFacetAndTheMeshVolume) {
+    for (const PlanarPart& p : planar_parts()) {
+        const Mesh mesh = heal(tessellate(p.shape, 0.1));
+        const ReadBack back = round_trip(mesh, ReverseMethod::kFacets, p.name, 1e-9);
+        EXPECT_EQ(back.faces, mesh.num_faces()) << p.name;
+    }
+}
+
+TEST(Reverse, SamplePartsWithCurvedFacesGiveValidSolidsWithBothMethods) {
+    SampleOptions o;
+    o.relative_deflection = 0.01;
+    o.with_step = false;
+    for (const char* name : {"pocket_block", "freeform_die"}) {
+        auto part = make_sample_part(name, o);
+        ASSERT_TRUE(part.ok()) << part.error().describe();
+        const Mesh mesh = heal(part->mesh);
+        round_trip(mesh, ReverseMethod::kFacets, name, 1e-9);
+        const ReadBack planar = round_trip(mesh, ReverseMethod::kPlanar, name, 1e-7);
+        EXPECT_LT(planar.faces, mesh.num_faces()) << name;  // flat faces merged
+    }
+}
+
+TEST(Reverse, OpenMeshGivesAShellAndAWarning) {
+    auto m = test::cube({0, 0, 0}, 10.0);
+    m.triangles.pop_back();
+    const Mesh mesh = heal(test::to_bucket(m));
+    const auto path = out_dir() / "open.step";
+    auto rev = reverse_to_step(mesh, path, {});
+    ASSERT_TRUE(rev.ok());
+    EXPECT_FALSE(rev->solid);
+    EXPECT_TRUE(rev->written);
+    ASSERT_FALSE(rev->warnings.empty());
+    EXPECT_NE(rev->warnings[0].find("open"), std::string::npos);
+    const ReadBack back = read_step(path);
+    EXPECT_EQ(back.solids, 0u);
+    EXPECT_GT(back.faces, 0u);
+}
+
+TEST(Reverse, SameMeshGivesByteIdenticalStep) {
+    const Mesh mesh = heal(tessellate(planar_parts()[0].shape, 0.1));
+    const auto a = out_dir() / "det_a.step", b = out_dir() / "det_b.step";
+    ASSERT_TRUE(reverse_to_step(mesh, a, {}).ok());
+    ASSERT_TRUE(reverse_to_step(mesh, b, {}).ok());
+    auto slurp = [](const std::filesystem::path& p) {
+        std::ifstream in(p, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    EXPECT_EQ(slurp(a), slurp(b));
+}
+
+TEST(Reverse, UnwritableOutputIsAnErrorAndLeavesNothing) {
+    const Mesh mesh = heal(test::to_bucket(test::cube()));
+    auto rev = reverse_to_step(mesh, out_dir() / "no_such_dir" / "x.step", {});
+    ASSERT_FALSE(rev.ok());
+    EXPECT_EQ(rev.error().code, ErrorCode::kCannotWrite);
+    EXPECT_FALSE(std::filesystem::exists(out_dir() / "no_such_dir"));
+}
+
+}  // namespace
+}  // namespace ncrev
