@@ -215,3 +215,52 @@ TEST(Reverse, UnwritableOutputIsAnErrorAndLeavesNothing) {
 
 }  // namespace
 }  // namespace ncrev
+
+namespace ncrev {
+namespace {
+
+TEST(Reverse, InchUnitAndOtherSchemasReadBackAsTheSameSolid) {
+    const Mesh mesh = heal(test::to_bucket(test::cube({0, 0, 0}, 1.0)));
+    ReverseOptions o;
+    o.unit = Unit::kInch;
+    o.schema = StepSchema::kAP242;
+    const auto path = out_dir() / "inch_cube.step";
+    auto rev = reverse_to_step(mesh, path, o);
+    ASSERT_TRUE(rev.ok());
+    std::ifstream in(path);
+    const std::string text(std::istreambuf_iterator<char>(in), {});
+    EXPECT_NE(text.find("AP242_MANAGED_MODEL_BASED_3D_ENGINEERING"), std::string::npos);
+    EXPECT_NE(text.find("CONVERSION_BASED_UNIT('INCH'"), std::string::npos);
+    const ReadBack back = read_step(path);  // OpenCASCADE converts to mm
+    EXPECT_TRUE(back.valid);
+    EXPECT_NEAR(back.volume, 25.4 * 25.4 * 25.4, 1e-6);
+    o.unit = Unit::kMillimetre;
+    o.schema = StepSchema::kAP203;
+    const auto path203 = out_dir() / "cube203.step";
+    ASSERT_TRUE(reverse_to_step(mesh, path203, o).ok());
+    const ReadBack b203 = read_step(path203);
+    EXPECT_TRUE(b203.valid);
+    EXPECT_NEAR(b203.volume, 1.0, 1e-12);
+}
+
+TEST(Reverse, ReportsFacesEdgesVerticesOfTheBrep) {
+    const Mesh mesh = heal(test::to_bucket(test::cube({0, 0, 0}, 2.0)));
+    ReverseOptions o;
+    auto planar = reverse_to_step(mesh, out_dir() / "cube_planar.step", o);
+    ASSERT_TRUE(planar.ok());
+    EXPECT_EQ(planar->faces, 6u);
+    EXPECT_EQ(planar->edges, 12u);
+    EXPECT_EQ(planar->vertices, 8u);
+    EXPECT_TRUE(planar->occt_checked);
+    EXPECT_DOUBLE_EQ(planar->solid_volume, 8.0);
+    EXPECT_DOUBLE_EQ(planar->solid_area, 24.0);
+    o.method = ReverseMethod::kFacets;
+    auto facets = reverse_to_step(mesh, out_dir() / "cube_facets.step", o);
+    ASSERT_TRUE(facets.ok());
+    EXPECT_EQ(facets->faces, 12u);
+    EXPECT_EQ(facets->edges, 18u);
+    EXPECT_EQ(facets->vertices, 8u);
+}
+
+}  // namespace
+}  // namespace ncrev

@@ -50,21 +50,23 @@ struct ReverseReport {
     std::string planar_tolerance_rule;                          ///< how it was chosen
     std::map<std::string, std::uint64_t> faces_by_kind;         ///< e.g. {"plane": 12}
     std::uint64_t faces = 0, edges = 0, vertices = 0;
-    bool solid = false;                       ///< a closed shell was made into a solid
-    bool valid = false;                       ///< BRepCheck_Analyzer found no defect
-    double solid_volume = 0, solid_area = 0;  ///< of the B-rep (BRepGProp)
+    bool solid = false;         ///< a closed shell was made into a solid
+    bool valid = false;         ///< the structural check (and BRepCheck_Analyzer) found no defect
+    bool occt_checked = false;  ///< BRepCheck_Analyzer ran too (B-reps of up to 5000 faces)
+    double solid_volume = 0, solid_area = 0;  ///< of the B-rep's faces
     double mesh_volume = 0, mesh_area = 0;    ///< of the mesh it came from
     bool written = false;  ///< the STEP file was written (not when the shape is invalid)
     std::uint64_t step_bytes = 0;
     std::vector<std::string> warnings;
 };
 
-/// Builds the B-rep of `mesh` with `options.method`, checks it (BRepCheck_Analyzer) and, when
-/// valid, writes it to `output` as STEP, atomically (a temporary file beside it, then a
-/// rename). An invalid shape is not written: `written` false, `valid` false. Fails with
-/// kCannotWrite when the file cannot be written, kEmpty for a mesh without facets, kBadValue
-/// when OpenCASCADE cannot build or transfer the shape (its reason in the message). An open
-/// mesh is not an error: it gives a shell, `solid` false and a warning.
+/// Builds the B-rep of `mesh` with `options.method`, checks it (a structural check always,
+/// BRepCheck_Analyzer too up to 5000 faces) and, when valid, writes it to `output` as STEP,
+/// atomically (a temporary file beside it, then a rename). An invalid shape is not written:
+/// `written` false, `valid` false. Fails with kCannotWrite when the file cannot be written, kEmpty
+/// for a mesh without facets, kBadValue when OpenCASCADE cannot build or transfer the shape (its
+/// reason in the message). An open mesh is not an error: it gives a shell, `solid` false and a
+/// warning.
 Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::path& output,
                                       const ReverseOptions& options = {});
 

@@ -34,6 +34,9 @@ namespace ncrev::brep_detail {
 namespace {
 
 constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+// Smallest tolerance given to vertices, edges and faces: OpenCASCADE's Precision::Confusion()
+// (1e-7 model units), below which its checks treat lengths as zero.
+constexpr double kMinTolerance = 1e-7;
 
 gp_Pnt pnt(Vec3 v) { return {v.x, v.y, v.z}; }
 
@@ -47,9 +50,9 @@ double distance_to_segment(Vec3 p, Vec3 a, Vec3 b) {
 
 }  // namespace
 
-PlanarBuild build_planar_shape(const Mesh& m, bool merge, double tol) {
+PlanarTopology planar_topology(const Mesh& m, bool merge, double tol) {
     const std::size_t nf = m.num_faces(), nh = m.num_halfedges(), nv = m.num_vertices();
-    PlanarBuild out;
+    PlanarTopology out;
 
     // 1. Regions.
     std::vector<std::uint32_t> region(nf, kNone);
@@ -223,36 +226,10 @@ PlanarBuild build_planar_shape(const Mesh& m, bool merge, double tol) {
         walk_chain(v, e);
     }
 
-    // 3. Vertices and edges of the B-rep.
-    const double shape_tol =
-        std::max(Precision::Confusion(), 1.001 * std::max(deviation, merge ? tol : 0.0));
-    out.tolerance = shape_tol;
-    BRep_Builder builder;
-    std::vector<TopoDS_Vertex> vertex(nv);
-    auto vertex_of = [&](std::uint32_t v) -> const TopoDS_Vertex& {
-        if (vertex[v].IsNull()) {
-            builder.MakeVertex(vertex[v], pnt(m.position(VertexId(v))), shape_tol);
-            ++out.vertices;
-        }
-        return vertex[v];
-    };
-    std::vector<TopoDS_Edge> edge(seg_ends.size());
-    for (std::size_t s = 0; s < seg_ends.size(); ++s) {
-        const Vec3 a = m.position(VertexId(seg_ends[s][0])),
-                   b = m.position(VertexId(seg_ends[s][1]));
-        const double len = norm(b - a);
-        Handle(Geom_Line) line = new Geom_Line(pnt(a), gp_Dir(b.x - a.x, b.y - a.y, b.z - a.z));
-        builder.MakeEdge(edge[s], line, shape_tol);
-        builder.Add(edge[s], vertex_of(seg_ends[s][0]).Oriented(TopAbs_FORWARD));
-        builder.Add(edge[s], vertex_of(seg_ends[s][1]).Oriented(TopAbs_REVERSED));
-        builder.Range(edge[s], 0.0, len);
-    }
-    out.edges = seg_ends.size();
-
-    // 4. Faces: loops of border half-edges per region.
+    // 3. Faces: loops of border half-edges per region, compressed to oriented segments.
+    out.tolerance = std::max(kMinTolerance, 1.001 * std::max(deviation, merge ? tol : 0.0));
+    out.segments = std::move(seg_ends);
     std::vector<std::uint8_t> walked(nh, 0);
-    TopoDS_Shell shell;
-    builder.MakeShell(shell);
     // Border half-edges grouped by region, in half-edge order.
     std::vector<std::uint32_t> start(num_regions + 1, 0), border;
     for (std::size_t hi = 0; hi < nh; ++hi) {
@@ -268,11 +245,7 @@ PlanarBuild build_planar_shape(const Mesh& m, bool merge, double tol) {
             }
         }
     }
-    struct Loop {
-        std::vector<std::pair<std::uint32_t, bool>> edges;  // (segment, forward)
-        double area = 0;
-    };
-    std::vector<Loop> loops;
+    std::vector<PlanarTopology::Loop> loops;
     std::vector<std::uint32_t> loop_h;
     for (std::uint32_t r = 0; r < num_regions; ++r) {
         loops.clear();
@@ -287,29 +260,30 @@ PlanarBuild build_planar_shape(const Mesh& m, bool merge, double tol) {
                 for (std::size_t g2 = 0; g2 <= nh && !is_border(g); ++g2) g = Mesh::next(m.twin(g));
                 h = g;
             }
-            // Rotate so that the loop starts at a segment's end, then compress.
+            // Rotate so that the loop starts where a segment starts, then compress.
             std::size_t first = 0;
             for (std::size_t i = 0; i < loop_h.size(); ++i) {
                 const HalfedgeId hh(loop_h[i]);
-                const std::uint32_t seg = seg_of[canonical(hh).idx()];
-                const VertexId o = m.origin(hh);
-                if (seg_ends[seg][0] == o.idx() || seg_ends[seg][1] == o.idx()) {
+                const auto& ends = out.segments[seg_of[canonical(hh).idx()]];
+                const std::uint32_t o = m.origin(hh).idx();
+                if (ends[0] == o || ends[1] == o) {
                     first = i;
                     break;
                 }
             }
-            Loop loop;
+            PlanarTopology::Loop loop;
             Vec3 area2{};
-            const Vec3 o = rc[r];
+            const Vec3 origin = rc[r];
             for (std::size_t i = 0; i < loop_h.size(); ++i) {
                 const HalfedgeId hh(loop_h[(first + i) % loop_h.size()]);
-                const Vec3 a = m.position(m.origin(hh)) - o, b = m.position(m.target(hh)) - o;
+                const Vec3 a = m.position(m.origin(hh)) - origin;
+                const Vec3 b = m.position(m.target(hh)) - origin;
                 area2 += cross(a, b);
                 const std::uint32_t seg = seg_of[canonical(hh).idx()];
                 if (!loop.edges.empty() && loop.edges.back().first == seg) continue;
-                // The segment runs seg_ends[0] -> [1] (straight within tol): hh runs along it
+                // The segment runs ends[0] -> ends[1] (straight within tol): hh runs along it
                 // when its origin is nearer to the segment's start than its target.
-                const Vec3 s0 = m.position(VertexId(seg_ends[seg][0]));
+                const Vec3 s0 = m.position(VertexId(out.segments[seg][0]));
                 const bool forward =
                     norm(m.position(m.origin(hh)) - s0) < norm(m.position(m.target(hh)) - s0);
                 loop.edges.emplace_back(seg, forward);
@@ -318,33 +292,128 @@ PlanarBuild build_planar_shape(const Mesh& m, bool merge, double tol) {
             loops.push_back(std::move(loop));
         }
         if (loops.empty()) continue;
+        // The loop of largest signed area is the outer wire; the others are holes.
         std::size_t outer = 0;
         for (std::size_t i = 1; i < loops.size(); ++i) {
             if (loops[i].area > loops[outer].area) outer = i;
         }
-        Handle(Geom_Plane) plane = new Geom_Plane(pnt(rc[r]), gp_Dir(rn[r].x, rn[r].y, rn[r].z));
+        std::swap(loops[0], loops[outer]);
+        out.faces.push_back({rc[r], rn[r], std::move(loops)});
+        loops = {};
+    }
+    out.closed = nf > 0;
+    for (std::size_t hi = 0; hi < nh && out.closed; ++hi) {
+        out.closed = !m.is_boundary(HalfedgeId(static_cast<std::uint32_t>(hi)));
+    }
+    return out;
+}
+
+std::string check_topology(const PlanarTopology& topo, const Mesh& m) {
+    std::vector<std::uint8_t> forward_uses(topo.segments.size(), 0),
+        backward_uses(topo.segments.size(), 0);
+    auto start_of = [&](std::pair<std::uint32_t, bool> e) {
+        return e.second ? topo.segments[e.first][0] : topo.segments[e.first][1];
+    };
+    auto end_of = [&](std::pair<std::uint32_t, bool> e) {
+        return e.second ? topo.segments[e.first][1] : topo.segments[e.first][0];
+    };
+    for (std::size_t s = 0; s < topo.segments.size(); ++s) {
+        const auto [a, b] = topo.segments[s];
+        if (a == b || norm(m.position(VertexId(a)) - m.position(VertexId(b))) <= topo.tolerance) {
+            return "segment " + std::to_string(s) + " has no length";
+        }
+    }
+    for (std::size_t f = 0; f < topo.faces.size(); ++f) {
+        const auto& face = topo.faces[f];
+        if (face.loops.empty()) return "face " + std::to_string(f) + " has no loop";
+        for (const auto& loop : face.loops) {
+            if (loop.edges.size() < 3)
+                return "face " + std::to_string(f) + " has a loop of fewer than 3 edges";
+            for (std::size_t k = 0; k < loop.edges.size(); ++k) {
+                const auto e = loop.edges[k];
+                if (end_of(e) != start_of(loop.edges[(k + 1) % loop.edges.size()])) {
+                    return "face " + std::to_string(f) + " has a loop that does not chain";
+                }
+                (e.second ? forward_uses : backward_uses)[e.first] += 1;
+                const Vec3 p = m.position(VertexId(start_of(e)));
+                if (std::abs(dot(p - face.origin, face.normal)) > topo.tolerance) {
+                    return "face " + std::to_string(f) + " has a vertex off its plane";
+                }
+            }
+        }
+    }
+    for (std::size_t s = 0; s < topo.segments.size(); ++s) {
+        const int fw = forward_uses[s], bw = backward_uses[s];
+        const bool shared = fw == 1 && bw == 1;
+        const bool boundary = !topo.closed && fw + bw == 1;
+        if (!shared && !boundary) {
+            return "segment " + std::to_string(s) + " is used " + std::to_string(fw) +
+                   " times forward and " + std::to_string(bw) + " times backward";
+        }
+    }
+    return {};
+}
+
+void measure_topology(const PlanarTopology& topo, const Mesh& m, double& area, double& volume) {
+    area = 0;
+    volume = 0;
+    for (const auto& face : topo.faces) {
+        double face_area = 0;
+        for (const auto& loop : face.loops) {
+            Vec3 a2{};
+            for (const auto& [seg, forward] : loop.edges) {
+                const Vec3 a =
+                    m.position(VertexId(topo.segments[seg][forward ? 0 : 1])) - face.origin;
+                const Vec3 b =
+                    m.position(VertexId(topo.segments[seg][forward ? 1 : 0])) - face.origin;
+                a2 += cross(a, b);
+            }
+            face_area += 0.5 * dot(a2, face.normal);
+        }
+        area += face_area;
+        volume += dot(face.origin, face.normal) * face_area / 3.0;
+    }
+}
+
+PlanarShape to_occt(const PlanarTopology& topo, const Mesh& m) {
+    PlanarShape out;
+    const double tol = topo.tolerance;
+    BRep_Builder builder;
+    std::vector<TopoDS_Vertex> vertex(m.num_vertices());
+    auto vertex_of = [&](std::uint32_t v) -> const TopoDS_Vertex& {
+        if (vertex[v].IsNull()) builder.MakeVertex(vertex[v], pnt(m.position(VertexId(v))), tol);
+        return vertex[v];
+    };
+    std::vector<TopoDS_Edge> edge(topo.segments.size());
+    for (std::size_t s = 0; s < topo.segments.size(); ++s) {
+        const Vec3 a = m.position(VertexId(topo.segments[s][0]));
+        const Vec3 b = m.position(VertexId(topo.segments[s][1]));
+        Handle(Geom_Line) line = new Geom_Line(pnt(a), gp_Dir(b.x - a.x, b.y - a.y, b.z - a.z));
+        builder.MakeEdge(edge[s], line, tol);
+        builder.Add(edge[s], vertex_of(topo.segments[s][0]).Oriented(TopAbs_FORWARD));
+        builder.Add(edge[s], vertex_of(topo.segments[s][1]).Oriented(TopAbs_REVERSED));
+        builder.Range(edge[s], 0.0, norm(b - a));
+    }
+    TopoDS_Shell shell;
+    builder.MakeShell(shell);
+    for (const PlanarTopology::Face& f : topo.faces) {
+        Handle(Geom_Plane) plane =
+            new Geom_Plane(pnt(f.origin), gp_Dir(f.normal.x, f.normal.y, f.normal.z));
         TopoDS_Face face;
-        builder.MakeFace(face, plane, shape_tol);
-        for (std::size_t li = 0; li < loops.size(); ++li) {
-            const Loop& loop = loops[li == 0 ? outer : (li <= outer ? li - 1 : li)];
+        builder.MakeFace(face, plane, tol);
+        for (const PlanarTopology::Loop& loop : f.loops) {
             TopoDS_Wire wire;
             builder.MakeWire(wire);
-            for (const auto& [seg, fwd] : loop.edges) {
-                builder.Add(wire, edge[seg].Oriented(fwd ? TopAbs_FORWARD : TopAbs_REVERSED));
+            for (const auto& [seg, forward] : loop.edges) {
+                builder.Add(wire, edge[seg].Oriented(forward ? TopAbs_FORWARD : TopAbs_REVERSED));
             }
             wire.Closed(true);
             builder.Add(face, wire);
         }
         builder.Add(shell, face);
-        ++out.faces;
     }
-
-    bool closed = nf > 0;
-    for (std::size_t hi = 0; hi < nh && closed; ++hi) {
-        closed = !m.is_boundary(HalfedgeId(static_cast<std::uint32_t>(hi)));
-    }
-    shell.Closed(closed);
-    if (closed) {
+    shell.Closed(topo.closed);
+    if (topo.closed) {
         TopoDS_Solid solid;
         builder.MakeSolid(solid);
         builder.Add(solid, shell);

@@ -3,6 +3,7 @@ list(APPEND NCREV_OCCT_SOURCES
     ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/planar.cpp
     ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/reverse.cpp
     ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/step.cpp
+    ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/step_direct.cpp
 )
 list(APPEND NCREV_OCCT_LIBS
     TKernel TKMath TKG2d TKG3d TKGeomBase TKBRep TKGeomAlgo TKTopAlgo TKShHealing

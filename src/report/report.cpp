@@ -157,6 +157,7 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
                     {"vertices", rev.vertices},
                     {"solid", rev.solid},
                     {"valid", rev.valid},
+                    {"occt_checked", rev.occt_checked},
                     {"closed_valid_solid", rev.solid && rev.valid},
                     {"mesh_volume", rev.mesh_volume},
                     {"mesh_area", rev.mesh_area},
