@@ -144,5 +144,3 @@ BENCHMARK(BM_ReadAndBuildFile)
 
 }  // namespace
 }  // namespace ncrev::bench
-
-BENCHMARK_MAIN();

@@ -89,3 +89,39 @@ TEST(StlWriter, BinaryHeaderNeverBeginsWithSolid) {
 
 }  // namespace
 }  // namespace ncrev
+
+namespace ncrev {
+namespace {
+
+TEST(AtomicFileWriter, WritesInPiecesAndLeavesNothingWithoutCommit) {
+    const auto dir = temp_dir("atomic_writer");
+    const auto path = dir / "out.txt";
+    {
+        auto w = AtomicFileWriter::open(path);
+        ASSERT_TRUE(w.ok());
+        const std::string a = "hello ", b = "world";
+        ASSERT_TRUE(w->write(std::as_bytes(std::span(a))).ok());
+        ASSERT_TRUE(w->write(std::as_bytes(std::span(b))).ok());
+    }  // abandoned
+    EXPECT_TRUE(std::filesystem::is_empty(dir));
+    {
+        auto w = AtomicFileWriter::open(path);
+        ASSERT_TRUE(w.ok());
+        const std::string a = "hello ", b = "world";
+        ASSERT_TRUE(w->write(std::as_bytes(std::span(a))).ok());
+        ASSERT_TRUE(w->write(std::as_bytes(std::span(b))).ok());
+        ASSERT_TRUE(w->commit().ok());
+    }
+    std::ifstream in(path);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "hello world");
+    std::size_t files = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+        (void)e;
+        ++files;
+    }
+    EXPECT_EQ(files, 1u);
+    std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace ncrev

@@ -139,6 +139,29 @@ class FileBytes {
 /// renamed over `path`. On failure nothing is left behind and `path` is untouched.
 Status write_file_atomic(const std::filesystem::path& path, std::span<const std::byte> bytes);
 
+/// Writes a file in pieces, atomically: a temporary file beside the target, renamed over it
+/// by commit(). Destroyed (or after a failed write) without commit(), it removes the
+/// temporary file and leaves the target untouched. Movable, not copyable.
+class AtomicFileWriter {
+   public:
+    static Result<AtomicFileWriter> open(const std::filesystem::path& path);
+    AtomicFileWriter() = default;
+    AtomicFileWriter(AtomicFileWriter&& other) noexcept;
+    AtomicFileWriter& operator=(AtomicFileWriter&& other) noexcept;
+    AtomicFileWriter(const AtomicFileWriter&) = delete;
+    AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+    ~AtomicFileWriter();
+
+    Status write(std::span<const std::byte> bytes);
+    /// Flushes to disk and renames the temporary file over the target.
+    Status commit();
+
+   private:
+    void abandon();
+    std::filesystem::path path_, tmp_;
+    int fd_ = -1;
+};
+
 /// Encodes a binary STL (80-byte header from `header`, normals computed from the vertices,
 /// coordinates rounded to float32).
 std::vector<std::byte> encode_stl_binary(std::span<const Vec3> points,

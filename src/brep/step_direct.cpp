@@ -64,6 +64,18 @@ std::string step_string(std::string_view s) {
 class StepText {
    public:
     explicit StepText(std::string& out) : out_(out) {}
+    /// Hands the text so far to the file when it exceeds a few MB: memory stays flat however
+    /// large the model (a 1M-facet STEP is over 1 GB of text).
+    Status flush_if_large(AtomicFileWriter& file) {
+        constexpr std::size_t kFlushBytes = std::size_t{4} << 20;
+        if (out_.size() < kFlushBytes) return Ok{};
+        return flush(file);
+    }
+    Status flush(AtomicFileWriter& file) {
+        Status s = file.write(std::as_bytes(std::span(out_)));
+        out_.clear();
+        return s;
+    }
     /// Starts entity #id = ...; returns the id.
     std::uint64_t begin() {
         const std::uint64_t id = ++next_;
@@ -118,8 +130,10 @@ class StepText {
 
 Status write_planar_step(const PlanarTopology& topo, const Mesh& m,
                          const std::filesystem::path& path, const StepWriteOptions& options) {
+    auto file = AtomicFileWriter::open(path);
+    if (!file) return file.error();
     std::string text;
-    text.reserve(512 + 400 * topo.segments.size() + 300 * topo.faces.size());
+    text.reserve(std::size_t{5} << 20);
     StepText st(text);
     const bool inch = options.unit == Unit::kInch;
     st.raw("ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('ncrev planar B-rep'),'2;1');\nFILE_NAME(");
@@ -244,6 +258,7 @@ Status write_planar_step(const PlanarTopology& topo, const Mesh& m,
         st.raw(",");
         st.ref(line);
         st.raw(",.T.);\n");
+        if (auto f = st.flush_if_large(*file); !f) return f;
     }
     std::vector<std::uint64_t> faces, bounds, oriented;
     faces.reserve(topo.faces.size());
@@ -297,6 +312,7 @@ Status write_planar_step(const PlanarTopology& topo, const Mesh& m,
         st.raw("),");
         st.ref(plane);
         st.raw(",.T.);\n");
+        if (auto s = st.flush_if_large(*file); !s) return s;
     }
     const auto shell = st.begin();
     st.raw(topo.closed ? "CLOSED_SHELL('',(" : "OPEN_SHELL('',(");
@@ -342,7 +358,8 @@ Status write_planar_step(const PlanarTopology& topo, const Mesh& m,
     st.raw(",");
     st.ref(rep);
     st.raw(");\nENDSEC;\nEND-ISO-10303-21;\n");
-    return write_file_atomic(path, std::as_bytes(std::span(text)));
+    if (auto s = st.flush(*file); !s) return s;
+    return file->commit();
 }
 
 }  // namespace ncrev::brep_detail

@@ -89,14 +89,19 @@ FileBytes::~FileBytes() {
     if (mapped_) ::munmap(const_cast<std::byte*>(data_), size_);
 }
 
-Status write_file_atomic(const std::filesystem::path& path, std::span<const std::byte> bytes) {
-    auto fail = [&](const std::string& what) -> Status {
-        Error e;
-        e.code = ErrorCode::kCannotWrite;
-        e.path = path.string();
-        e.message = what;
-        return e;
-    };
+namespace {
+
+Error write_error(const std::filesystem::path& path, const std::string& what) {
+    Error e;
+    e.code = ErrorCode::kCannotWrite;
+    e.path = path.string();
+    e.message = what;
+    return e;
+}
+
+}  // namespace
+
+Result<AtomicFileWriter> AtomicFileWriter::open(const std::filesystem::path& path) {
     const std::filesystem::path dir =
         path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
     // A unique temporary name beside the target so that rename() is atomic (same filesystem).
@@ -106,39 +111,81 @@ Status write_file_atomic(const std::filesystem::path& path, std::span<const std:
                   static_cast<unsigned>(::getpid()) & 0xffffu);
     std::string tmp_name = ".";
     tmp_name.append(path.filename().string()).append(suffix);
-    const std::filesystem::path tmp = dir / tmp_name;
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (fd < 0)
-        return fail(std::string("cannot create a file in ") + dir.string() + ": " +
-                    std::strerror(errno));
+    AtomicFileWriter w;
+    w.path_ = path;
+    w.tmp_ = dir / tmp_name;
+    w.fd_ = ::open(w.tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (w.fd_ < 0) {
+        return write_error(path, std::string("cannot create a file in ") + dir.string() + ": " +
+                                     std::strerror(errno));
+    }
+    return w;
+}
+
+AtomicFileWriter::AtomicFileWriter(AtomicFileWriter&& other) noexcept { *this = std::move(other); }
+
+AtomicFileWriter& AtomicFileWriter::operator=(AtomicFileWriter&& other) noexcept {
+    if (this == &other) return *this;
+    abandon();
+    path_ = std::move(other.path_);
+    tmp_ = std::move(other.tmp_);
+    fd_ = other.fd_;
+    other.fd_ = -1;
+    return *this;
+}
+
+AtomicFileWriter::~AtomicFileWriter() { abandon(); }
+
+void AtomicFileWriter::abandon() {
+    if (fd_ < 0) return;
+    ::close(fd_);
+    ::unlink(tmp_.c_str());
+    fd_ = -1;
+}
+
+Status AtomicFileWriter::write(std::span<const std::byte> bytes) {
+    if (fd_ < 0) return write_error(path_, "the file is closed");
     std::size_t done = 0;
     while (done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        const ssize_t n = ::write(fd_, bytes.data() + done, bytes.size() - done);
         if (n < 0) {
             if (errno == EINTR) continue;
             const int err = errno;
-            ::close(fd);
-            ::unlink(tmp.c_str());
-            return fail(std::string("cannot write: ") + std::strerror(err));
+            abandon();
+            return write_error(path_, std::string("cannot write: ") + std::strerror(err));
         }
         done += static_cast<std::size_t>(n);
     }
-    if (::fsync(fd) != 0 && errno != EINVAL) {
+    return Ok{};
+}
+
+Status AtomicFileWriter::commit() {
+    if (fd_ < 0) return write_error(path_, "the file is closed");
+    if (::fsync(fd_) != 0 && errno != EINVAL) {
         const int err = errno;
-        ::close(fd);
-        ::unlink(tmp.c_str());
-        return fail(std::string("cannot flush: ") + std::strerror(err));
+        abandon();
+        return write_error(path_, std::string("cannot flush: ") + std::strerror(err));
     }
+    const int fd = fd_;
+    fd_ = -1;
     if (::close(fd) != 0) {
-        ::unlink(tmp.c_str());
-        return fail(std::string("cannot close: ") + std::strerror(errno));
-    }
-    if (::rename(tmp.c_str(), path.c_str()) != 0) {
         const int err = errno;
-        ::unlink(tmp.c_str());
-        return fail(std::string("cannot rename into place: ") + std::strerror(err));
+        ::unlink(tmp_.c_str());
+        return write_error(path_, std::string("cannot close: ") + std::strerror(err));
+    }
+    if (::rename(tmp_.c_str(), path_.c_str()) != 0) {
+        const int err = errno;
+        ::unlink(tmp_.c_str());
+        return write_error(path_, std::string("cannot rename into place: ") + std::strerror(err));
     }
     return Ok{};
+}
+
+Status write_file_atomic(const std::filesystem::path& path, std::span<const std::byte> bytes) {
+    auto w = AtomicFileWriter::open(path);
+    if (!w) return w.error();
+    if (auto s = w->write(bytes); !s) return s;
+    return w->commit();
 }
 
 }  // namespace ncrev
