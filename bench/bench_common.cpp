@@ -82,6 +82,56 @@ const TriangleSoup& torus_soup(std::size_t facets) {
     return cache.emplace(facets, std::move(s)).first->second;
 }
 
+const TriangleSoup& box_grid_soup(std::size_t facets) {
+    static std::map<std::size_t, TriangleSoup> cache;
+    auto it = cache.find(facets);
+    if (it != cache.end()) return it->second;
+    const auto n = std::max<std::size_t>(1, static_cast<std::size_t>(
+                                                std::sqrt(static_cast<double>(facets) / 12.0)));
+    const Vec3 size{100, 60, 40};
+    TriangleSoup s;
+    // Face (axis a, side): a grid over the two other axes, counter-clockwise from outside.
+    for (int a = 0; a < 3; ++a) {
+        for (int side = 0; side < 2; ++side) {
+            const int u = (a + 1) % 3, v = (a + 2) % 3;
+            auto corner = [&](std::size_t i, std::size_t j) {
+                Vec3 p;
+                p[a] = side ? size[a] : 0.0;
+                p[u] = size[u] * static_cast<double>(i) / static_cast<double>(n);
+                p[v] = size[v] * static_cast<double>(j) / static_cast<double>(n);
+                return Vec3{static_cast<float>(p.x), static_cast<float>(p.y),
+                            static_cast<float>(p.z)};
+            };
+            for (std::size_t i = 0; i < n; ++i) {
+                for (std::size_t j = 0; j < n; ++j) {
+                    Vec3 q[4] = {corner(i, j), corner(i + 1, j), corner(i + 1, j + 1),
+                                 corner(i, j + 1)};
+                    if (!side) std::swap(q[1], q[3]);  // the low side faces the other way
+                    for (int t = 0; t < 2; ++t) {
+                        const auto k = static_cast<std::uint32_t>(s.points.size());
+                        s.points.push_back(q[0]);
+                        s.points.push_back(q[1 + t]);
+                        s.points.push_back(q[2 + t]);
+                        s.triangles.push_back({k, k + 1, k + 2});
+                    }
+                }
+            }
+        }
+    }
+    return cache.emplace(facets, std::move(s)).first->second;
+}
+
+std::filesystem::path box_grid_file(std::size_t facets) {
+    const auto path = std::filesystem::temp_directory_path() /
+                      ("ncrev_bench_box_" + std::to_string(facets) + ".stl");
+    const auto& s = box_grid_soup(facets);
+    const auto bytes = encode_stl_binary(s.points, s.triangles, "box");
+    if (!std::filesystem::exists(path) || std::filesystem::file_size(path) != bytes.size()) {
+        if (!write_file_atomic(path, bytes).ok()) std::abort();
+    }
+    return path;
+}
+
 const std::vector<std::byte>& stl_binary_bytes(std::size_t facets) {
     static std::map<std::size_t, std::vector<std::byte>> cache;
     auto it = cache.find(facets);

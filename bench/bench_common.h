@@ -16,6 +16,12 @@ namespace ncrev::bench {
 /// A closed torus grid (R = 60 mm, r = 25 mm) with about `facets` facets (2·nu·nv), written
 /// facet by facet as a CAD exporter does. Cached.
 const TriangleSoup& torus_soup(std::size_t facets);
+/// A prismatic part: a 100 x 60 x 40 mm box whose six faces are each a grid of n x n quads
+/// (about `facets` facets), as a fine simulator mesh of a planar part is. Cached.
+const TriangleSoup& box_grid_soup(std::size_t facets);
+/// The box grid as a binary STL on disk (for the FreeCAD comparison).
+std::filesystem::path box_grid_file(std::size_t facets);
+
 /// Encodings of the same mesh, cached.
 const std::vector<std::byte>& stl_binary_bytes(std::size_t facets);
 const std::string& stl_ascii_text(std::size_t facets);

@@ -9,10 +9,9 @@
 namespace ncrev::bench {
 namespace {
 
-void BM_Reverse(benchmark::State& state) {
+void run_reverse(benchmark::State& state, const TriangleSoup& soup) {
     const auto method = state.range(0) == 0 ? ReverseMethod::kFacets : ReverseMethod::kPlanar;
-    const auto n = static_cast<std::size_t>(state.range(1));
-    auto built = build_mesh(torus_soup(n));
+    auto built = build_mesh(soup);
     if (!built) {
         state.SkipWithError("build failed");
         return;
@@ -44,6 +43,23 @@ void BM_Reverse(benchmark::State& state) {
     state.counters["peak_heap_B_per_facet"] = peak_per_facet;
     state.SetLabel(to_string(method));
 }
+
+// A curved part: a torus grid (planar merges only the planar quads).
+void BM_Reverse(benchmark::State& state) {
+    run_reverse(state, torus_soup(static_cast<std::size_t>(state.range(1))));
+}
+
+// A prismatic part: a box of n x n grids (planar gives its 6 faces).
+void BM_ReversePrismatic(benchmark::State& state) {
+    run_reverse(state, box_grid_soup(static_cast<std::size_t>(state.range(1))));
+    // Written for the FreeCAD comparison (bench/freecad_reverse.py).
+    benchmark::DoNotOptimize(box_grid_file(static_cast<std::size_t>(state.range(1))));
+}
+BENCHMARK(BM_ReversePrismatic)
+    ->ArgsProduct({{0, 1}, {10'000, 100'000}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 BENCHMARK(BM_Reverse)
     ->ArgsProduct({{0, 1}, {10'000, 100'000}})
     ->Unit(benchmark::kMillisecond)
