@@ -86,8 +86,8 @@ const TriangleSoup& box_grid_soup(std::size_t facets) {
     static std::map<std::size_t, TriangleSoup> cache;
     auto it = cache.find(facets);
     if (it != cache.end()) return it->second;
-    const auto n = std::max<std::size_t>(1, static_cast<std::size_t>(
-                                                std::sqrt(static_cast<double>(facets) / 12.0)));
+    const auto n = std::max<std::size_t>(
+        1, static_cast<std::size_t>(std::sqrt(static_cast<double>(facets) / 12.0)));
     const Vec3 size{100, 60, 40};
     TriangleSoup s;
     // Face (axis a, side): a grid over the two other axes, counter-clockwise from outside.

@@ -2,6 +2,7 @@
 // header's facet count, because many binary files begin with the word "solid".
 #include <bit>
 #include <cstring>
+#include <optional>
 
 #include "detail/exact_weld.h"
 #include "io/text.h"
@@ -41,6 +42,19 @@ std::uint32_t float_key(float v) {
     return b == 0x80000000u ? 0u : b;  // -0 and +0 are the same point
 }
 
+/// The welder's distinct points become the soup's points (`input_points` were read).
+void take_welded_points(const detail::ExactWelder<std::uint32_t>& welder,
+                        std::uint64_t input_points, TriangleSoup& soup) {
+    soup.welded_points = input_points - welder.size();
+    soup.points.resize(welder.size());
+    for (std::size_t c = 0; c < welder.size(); ++c) {
+        const auto& k = welder.keys()[c];
+        soup.points[c] = {std::bit_cast<float>(k[0]), std::bit_cast<float>(k[1]),
+                          std::bit_cast<float>(k[2])};
+    }
+    soup.points_distinct = true;
+}
+
 /// Exact weld of a bucket soup whose points are float32 values (as every STL's are).
 void weld_float_points(TriangleSoup& soup) {
     detail::ExactWelder<std::uint32_t> welder(soup.points.size());
@@ -54,15 +68,8 @@ void weld_float_points(TriangleSoup& soup) {
     for (auto& t : soup.triangles) {
         for (auto& v : t) v = id[v];
     }
-    soup.welded_points = soup.points.size() - welder.size();
-    soup.points.resize(welder.size());
-    for (std::size_t c = 0; c < welder.size(); ++c) {
-        const auto& k = welder.keys()[c];
-        soup.points[c] = {std::bit_cast<float>(k[0]), std::bit_cast<float>(k[1]),
-                          std::bit_cast<float>(k[2])};
-    }
+    take_welded_points(welder, soup.points.size(), soup);
     soup.points.shrink_to_fit();
-    soup.points_distinct = true;
 }
 
 Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_view name,
@@ -86,6 +93,18 @@ Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_v
     }
     soup.triangles.resize(n);
     const std::byte* rec = bytes.data() + kStlHeaderBytes;
+    // The nine coordinates of facet f; an error naming the byte of the first non-finite one.
+    auto load = [&](std::uint64_t f, const std::byte* r, float* c) -> std::optional<Error> {
+        std::memcpy(c, r + 12, 9 * sizeof(float));
+        bool finite = true;
+        for (int k = 0; k < 9; ++k) finite &= std::isfinite(c[k]);
+        if (finite) return std::nullopt;
+        int k = 0;
+        while (std::isfinite(c[k])) ++k;
+        return make_error(ErrorCode::kBadNumber, name,
+                          "facet " + std::to_string(f) + " has a non-finite coordinate", -1,
+                          static_cast<std::int64_t>(r - bytes.data()) + 12 + 4 * k);
+    };
     if (weld) {
         // Weld while reading: the soup holds each vertex once (a third of the memory of
         // three points per facet) and the keys are the file's own float32 bits.
@@ -95,16 +114,7 @@ Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_v
         constexpr std::uint64_t kPrefetchFacets = 8;
         for (std::uint64_t f = 0; f < n; ++f, rec += kStlRecordBytes) {
             float c[9];
-            std::memcpy(c, rec + 12, sizeof c);
-            bool finite = true;
-            for (float v : c) finite &= std::isfinite(v);
-            if (!finite) {
-                int k = 0;
-                while (std::isfinite(c[k])) ++k;
-                return make_error(ErrorCode::kBadNumber, name,
-                                  "facet " + std::to_string(f) + " has a non-finite coordinate", -1,
-                                  static_cast<std::int64_t>(rec - bytes.data()) + 12 + 4 * k);
-            }
+            if (auto bad = load(f, rec, c)) return *bad;
             if (f + kPrefetchFacets < n) {
                 float a[9];
                 std::memcpy(a, rec + kPrefetchFacets * kStlRecordBytes + 12, sizeof a);
@@ -118,30 +128,14 @@ Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_v
                     {float_key(c[3 * k]), float_key(c[3 * k + 1]), float_key(c[3 * k + 2])});
             }
         }
-        soup.points.resize(welder.size());
-        for (std::size_t i = 0; i < welder.size(); ++i) {
-            const auto& k = welder.keys()[i];
-            soup.points[i] = {std::bit_cast<float>(k[0]), std::bit_cast<float>(k[1]),
-                              std::bit_cast<float>(k[2])};
-        }
-        soup.welded_points = 3 * n - welder.size();
-        soup.points_distinct = true;
+        take_welded_points(welder, 3 * n, soup);
         return soup;
     }
     soup.points.resize(3 * n);
     Vec3* out = soup.points.data();
     for (std::uint64_t f = 0; f < n; ++f, rec += kStlRecordBytes) {
         float c[9];
-        std::memcpy(c, rec + 12, sizeof c);
-        bool finite = true;
-        for (float v : c) finite &= std::isfinite(v);
-        if (!finite) {
-            int k = 0;
-            while (std::isfinite(c[k])) ++k;
-            return make_error(ErrorCode::kBadNumber, name,
-                              "facet " + std::to_string(f) + " has a non-finite coordinate", -1,
-                              static_cast<std::int64_t>(rec - bytes.data()) + 12 + 4 * k);
-        }
+        if (auto bad = load(f, rec, c)) return *bad;
         out[3 * f + 0] = {c[0], c[1], c[2]};
         out[3 * f + 1] = {c[3], c[4], c[5]};
         out[3 * f + 2] = {c[6], c[7], c[8]};
