@@ -18,30 +18,13 @@ using io_detail::quote;
 // what the remaining bytes could hold, however large the announced count.
 constexpr std::size_t kMinRecordBytes = 6;
 
-struct SurfaceKindInfo {
-    std::string_view keyword;
-    SurfaceKind kind;
-    int num_params;
-};
-constexpr SurfaceKindInfo kSurfaceKinds[] = {
-    {"plane", SurfaceKind::kPlane, 6},
-    {"cylinder", SurfaceKind::kCylinder, 7},
-    {"cone", SurfaceKind::kCone, 8},
-    {"sphere", SurfaceKind::kSphere, 4},
-    {"torus", SurfaceKind::kTorus, 8},
-    {"shear_cylinder", SurfaceKind::kShearCylinder, 10},
-    {"swept_torus", SurfaceKind::kSweptTorus, 11},
-};
-
-struct ToolKindInfo {
-    std::string_view keyword;
-    ToolKind kind;
-};
-constexpr ToolKindInfo kToolKinds[] = {{"flat", ToolKind::kFlat},
-                                       {"ball", ToolKind::kBall},
-                                       {"bullnose", ToolKind::kBullnose},
-                                       {"drill", ToolKind::kDrill},
-                                       {"other", ToolKind::kOther}};
+// Keywords and parameter counts come from to_string() and num_surface_params() (writers.cpp),
+// so reader and writer cannot disagree.
+constexpr SurfaceKind kSurfaceKinds[] = {
+    SurfaceKind::kPlane, SurfaceKind::kCylinder,      SurfaceKind::kCone,      SurfaceKind::kSphere,
+    SurfaceKind::kTorus, SurfaceKind::kShearCylinder, SurfaceKind::kSweptTorus};
+constexpr ToolKind kToolKinds[] = {ToolKind::kFlat, ToolKind::kBall, ToolKind::kBullnose,
+                                   ToolKind::kDrill, ToolKind::kOther};
 
 bool is_block_keyword(std::string_view s) {
     return s == "unit" || s == "tools" || s == "surfaces" || s == "vertices" || s == "facets";
@@ -305,9 +288,9 @@ class SreParser {
         ToolRecord t;
         if (auto s = integer(f[1], t.color); !s) return s;
         bool known = false;
-        for (const auto& k : kToolKinds) {
-            if (f[2] == k.keyword) {
-                t.kind = k.kind;
+        for (ToolKind k : kToolKinds) {
+            if (f[2] == to_string(k)) {
+                t.kind = k;
                 known = true;
             }
         }
@@ -339,24 +322,25 @@ class SreParser {
         }
         std::int64_t index = 0;
         if (auto s = integer(f[0], index); !s) return s;
-        const SurfaceKindInfo* info = nullptr;
-        for (const auto& k : kSurfaceKinds) {
-            if (f[1] == k.keyword) info = &k;
+        const SurfaceKind* kind = nullptr;
+        for (const SurfaceKind& k : kSurfaceKinds) {
+            if (f[1] == to_string(k)) kind = &k;
         }
-        if (info == nullptr) {
+        if (kind == nullptr) {
             return error(ErrorCode::kBadValue,
                          "unknown surface kind " + quote(f[1]) +
                              ", expected plane, cylinder, cone, sphere, torus, shear_cylinder or "
                              "swept_torus");
         }
-        if (f.size() != static_cast<std::size_t>(2 + info->num_params)) {
+        const int num_params = num_surface_params(*kind);
+        if (f.size() != static_cast<std::size_t>(2 + num_params)) {
             return error(ErrorCode::kBadSyntax,
-                         std::string(info->keyword) + " takes " + std::to_string(info->num_params) +
+                         std::string(to_string(*kind)) + " takes " + std::to_string(num_params) +
                              " parameters, found " + std::to_string(f.size() - 2));
         }
         SurfaceRecord r;
-        r.kind = info->kind;
-        for (int i = 0; i < info->num_params; ++i) {
+        r.kind = *kind;
+        for (int i = 0; i < num_params; ++i) {
             if (auto s = number(f[2 + i], r.params[i]); !s) return s;
         }
         if (auto s = validate_surface(r); !s) return s;
