@@ -80,7 +80,10 @@ void add_reverse(CLI::App& app, Context& ctx) {
         ro.progress = progress;
         auto rev = reverse_to_step(healed->mesh, out, ro);
         if (!rev) {
-            print_error(rev.error().describe());
+            // A mesh with nothing to write is the input's fault: name the input.
+            print_error(rev.error().code == ErrorCode::kEmpty
+                            ? o->input + ": " + rev.error().message
+                            : rev.error().describe());
             ctx.exit_code =
                 rev.error().code == ErrorCode::kCannotWrite ? kExitCannotWrite : kExitNoResult;
             return;
