@@ -37,13 +37,16 @@ void add_reverse(CLI::App& app, Context& ctx) {
     cmd->add_option("-o,--output", o->output, "STEP file to write (atomically)")->required();
     const std::map<std::string, ReverseMethod> methods{{"facets", ReverseMethod::kFacets},
                                                        {"planar", ReverseMethod::kPlanar}};
-    cmd->add_option("--method", o->method, "facets | planar (default planar)")
-        ->transform(CLI::CheckedTransformer(methods, CLI::ignore_case));
+    cmd->add_option("--method", o->method,
+                    "facets: one planar face per facet; planar: coplanar facets merged (default)")
+        ->transform(CLI::CheckedTransformer(methods, CLI::ignore_case))
+        ->option_text("facets|planar");
     const std::map<std::string, StepSchema> schemas{{"ap214", StepSchema::kAP214},
                                                     {"ap203", StepSchema::kAP203},
                                                     {"ap242", StepSchema::kAP242}};
-    cmd->add_option("--schema", o->schema, "STEP schema: ap214 (default), ap203, ap242")
-        ->transform(CLI::CheckedTransformer(schemas, CLI::ignore_case));
+    cmd->add_option("--schema", o->schema, "STEP application protocol (default ap214)")
+        ->transform(CLI::CheckedTransformer(schemas, CLI::ignore_case))
+        ->option_text("ap214|ap203|ap242");
     cmd->add_option("--report", o->report,
                     "Write a JSON report: stages with timings, healing, faces by kind, edges, "
                     "vertices, whether the result is a closed valid solid, volumes and areas");
