@@ -169,6 +169,22 @@ Result<BuildResult> build_mesh(TriangleSoup&& soup, const HealOptions& options =
 /// Counts, area, volume, bounding box, boundary loops of a mesh.
 MeshStats compute_stats(const Mesh& mesh);
 
+/// Signed dihedral angle at the edge of `h`, in radians, in [-pi, pi]: the angle between the
+/// normals of its two facets, positive where the surface is convex (it bends away from the
+/// outward normals), negative where concave, 0 on a boundary edge or between coplanar facets.
+/// The normal-cycle curvature estimator (method.md 3.1) weighs edges by it.
+double dihedral_angle(const Mesh& mesh, HalfedgeId h);
+
+/// Mixed Voronoi area of every vertex (Meyer, Desbrun, Schröder, Barr 2003): each triangle
+/// gives its vertices their Voronoi share when it has no obtuse angle; otherwise half its area
+/// to the obtuse vertex and a quarter to each other. The areas sum to the mesh area, and stay
+/// positive on the long thin triangles of CAD tessellations.
+VertexMap<double> mixed_voronoi_areas(const Mesh& mesh);
+
+/// Unit vertex normals, each facet weighted by its angle at the vertex (independent of how
+/// the surface around the vertex is split into triangles).
+VertexMap<Vec3> vertex_normals(const Mesh& mesh);
+
 /// The default weld tolerance for points whose bounding box is `box`, and its rule in words.
 double default_weld_tolerance(const Box3& box, std::string* rule = nullptr);
 
