@@ -30,6 +30,8 @@ if [[ "${NCREV_SKIP_FUZZ:-0}" != "1" ]]; then
     for target in stl_reader sre_reader mesh_build; do
         work=$(mktemp -d)
         cp -r "fuzz/seeds/${target}/." "$work/" 2>/dev/null || true
+        # The bundled binary STL serves as a binary seed (libFuzzer cuts it to -max_len).
+        [[ "$target" == stl_reader ]] && cp examples/pocket_block.stl "$work/"
         echo "-- fuzz_${target}"
         log=$(mktemp)
         if ! ./build-fuzz/bin/fuzz_${target} -max_total_time="$fuzz_seconds" -max_len=4096 \

@@ -2,12 +2,18 @@
 
 #include <cstring>
 #include <fstream>
+#include <iterator>
 
 #include "ncrev/io.h"
 #include "test_meshes.h"
 
 namespace ncrev {
 namespace {
+
+std::size_t count_entries(const std::filesystem::path& dir) {
+    return static_cast<std::size_t>(std::distance(std::filesystem::directory_iterator(dir),
+                                                  std::filesystem::directory_iterator()));
+}
 
 std::filesystem::path temp_dir(const std::string& name) {
     auto d = std::filesystem::temp_directory_path() / ("ncrev_test_" + name);
@@ -64,12 +70,7 @@ TEST(AtomicWrite, ReplacesExistingFileAndLeavesNoTemporary) {
     const auto c = test::cube();
     ASSERT_TRUE(write_file_atomic(path, encode_stl_binary(c.points, c.triangles)).ok());
     EXPECT_EQ(std::filesystem::file_size(path), 84u + 50u * 12u);
-    std::size_t files = 0;
-    for (const auto& e : std::filesystem::directory_iterator(dir)) {
-        (void)e;
-        ++files;
-    }
-    EXPECT_EQ(files, 1u);
+    EXPECT_EQ(count_entries(dir), 1u);
     std::filesystem::remove_all(dir);
 }
 
@@ -114,12 +115,7 @@ TEST(AtomicFileWriter, WritesInPiecesAndLeavesNothingWithoutCommit) {
     }
     std::ifstream in(path);
     EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "hello world");
-    std::size_t files = 0;
-    for (const auto& e : std::filesystem::directory_iterator(dir)) {
-        (void)e;
-        ++files;
-    }
-    EXPECT_EQ(files, 1u);
+    EXPECT_EQ(count_entries(dir), 1u);
     std::filesystem::remove_all(dir);
 }
 

@@ -9,6 +9,17 @@
 namespace ncrev {
 namespace {
 
+/// Sum of the mixed areas, each asserted positive.
+double positive_area_sum(const Mesh& m) {
+    const VertexMap<double> areas = mixed_voronoi_areas(m);
+    double sum = 0;
+    for (double x : areas.data()) {
+        EXPECT_GT(x, 0);
+        sum += x;
+    }
+    return sum;
+}
+
 Mesh build(const TriangleSoup& soup, bool orient = true) {
     HealOptions o;
     o.orient = orient;
@@ -53,12 +64,7 @@ TEST(MeshGeometry, BoundaryEdgesHaveNoDihedral) {
 
 TEST(MeshGeometry, MixedAreasSumToTheAreaAndStayPositiveOnThinTriangles) {
     const Mesh sphere = build(test::to_bucket(test::icosphere(2.0, 3)));
-    const auto a = mixed_voronoi_areas(sphere);
-    double sum = 0;
-    for (double x : a.data()) {
-        EXPECT_GT(x, 0);
-        sum += x;
-    }
+    const double sum = positive_area_sum(sphere);
     EXPECT_NEAR(sum, compute_stats(sphere).area, 1e-12 * sum);
     // A strip of long thin, obtuse triangles, as CAD systems tessellate a cylinder.
     test::Indexed strip;
@@ -71,12 +77,7 @@ TEST(MeshGeometry, MixedAreasSumToTheAreaAndStayPositiveOnThinTriangles) {
         strip.triangles.push_back({2 * i + 1, 2 * i + 3, 2 * i + 2});
     }
     const Mesh thin = build(test::to_indexed_soup(strip));
-    const auto b = mixed_voronoi_areas(thin);
-    double sum_b = 0;
-    for (double x : b.data()) {
-        EXPECT_GT(x, 0);
-        sum_b += x;
-    }
+    const double sum_b = positive_area_sum(thin);
     EXPECT_NEAR(sum_b, compute_stats(thin).area, 1e-12 * sum_b);
 }
 
