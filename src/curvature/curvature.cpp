@@ -1,0 +1,616 @@
+// Discrete curvature (../shared/docs/method.md 3.1-3.4): the normal-cycle shape operator of
+// D. Cohen-Steiner and J.-M. Morvan, "Restricted Delaunay triangulations and normal cycle"
+// (SoCG 2003), over unions of mixed Voronoi cells (M. Meyer, M. Desbrun, P. Schröder,
+// A. Barr, "Discrete differential-geometry operators for triangulated 2-manifolds", 2003),
+// with the edge weights of S. Anwer et al., "Reverse engineering for NC machining simulation"
+// (2010) as an option; shape index and curvedness of J. Koenderink and A. van Doorn, "Surface
+// shape and curvature scales" (1992).
+//
+// Why unions of cells: the boundary of a mixed Voronoi cell crosses every edge of its vertex at
+// the edge's midpoint, so |e n B| is half the edge for each cell of B that holds an end of e.
+// The tensor of B is then the sum of per-vertex tensors T_v = sum_{e at v} beta(e) |e|/2 e e^T
+// and its area the sum of the cell areas: computed once per vertex, summed per neighbourhood.
+#include "ncrev/curvature.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <queue>
+#include <utility>
+#include <vector>
+
+namespace ncrev {
+
+const char* to_string(CurvatureEstimator estimator) {
+    return estimator == CurvatureEstimator::kWeighted ? "weighted" : "plain";
+}
+
+const char* to_string(Neighbourhood neighbourhood) {
+    switch (neighbourhood) {
+        case Neighbourhood::kKernel:
+            return "kernel";
+        case Neighbourhood::kRings:
+            return "rings";
+        case Neighbourhood::kGeodesic:
+            return "geodesic";
+    }
+    return "unknown";
+}
+
+const char* to_string(ShapeType type) {
+    static constexpr const char* kNames[kNumShapeTypes] = {
+        "plane",  "cup",          "trough", "rut",  "saddle_rut",
+        "saddle", "saddle_ridge", "ridge",  "dome", "cap"};
+    const auto i = static_cast<int>(type);
+    return i >= 0 && i < kNumShapeTypes ? kNames[i] : "unknown";
+}
+
+std::array<std::uint8_t, 3> shape_type_color(ShapeType type) {
+    static constexpr std::array<std::uint8_t, 3> kColors[kNumShapeTypes] = {
+        {{160, 160, 160}},  // plane: grey
+        {{0, 40, 200}},     // cup: deep blue
+        {{0, 110, 230}},    // trough
+        {{0, 190, 230}},    // rut: cyan
+        {{0, 200, 140}},    // saddle rut
+        {{40, 180, 40}},    // saddle: green
+        {{160, 210, 0}},    // saddle ridge
+        {{250, 220, 0}},    // ridge: yellow
+        {{250, 140, 0}},    // dome: orange
+        {{220, 30, 30}},    // cap: red
+    };
+    const auto i = static_cast<int>(type);
+    return i >= 0 && i < kNumShapeTypes ? kColors[i] : std::array<std::uint8_t, 3>{0, 0, 0};
+}
+
+double shape_index(double k1, double k2) {
+    if (k1 < k2) std::swap(k1, k2);
+    const double sum = k1 + k2, diff = k1 - k2;
+    if (diff == 0) return sum > 0 ? 1.0 : (sum < 0 ? -1.0 : 0.0);
+    return (2.0 / std::numbers::pi) * std::atan(sum / diff);
+}
+
+double curvedness(double k1, double k2) { return std::sqrt(0.5 * (k1 * k1 + k2 * k2)); }
+
+ShapeType classify_shape(double k1, double k2, double planar_curvedness) {
+    if (!(curvedness(k1, k2) >= planar_curvedness)) return ShapeType::kPlane;
+    const double s = shape_index(k1, k2);
+    // Koenderink's classes, symmetric about the saddle (s = 0); a value exactly on a bound
+    // goes to the class nearer the saddle.
+    const double a = std::fabs(s);
+    int step;  // 0 saddle, 1 saddle ridge/rut, 2 ridge/rut, 3 dome/trough, 4 cap/cup
+    if (a <= 0.125) {
+        step = 0;
+    } else if (a <= 0.375) {
+        step = 1;
+    } else if (a <= 0.625) {
+        step = 2;
+    } else if (a <= 0.875) {
+        step = 3;
+    } else {
+        step = 4;
+    }
+    return static_cast<ShapeType>(s >= 0 ? 5 + step : 5 - step);
+}
+
+namespace {
+
+/// Curvature radii above this multiple of the model's bounding-box diagonal are planar: such a
+/// surface deviates from its tangent plane by less than diagonal / 800 across the whole part.
+constexpr double kPlanarRadiusFactor = 100.0;
+/// Noise floor of the estimator on a plane whose coordinates were rounded to a precision eps:
+/// the normals of facets with edges of length l tilt by up to about 2 eps / l, which the
+/// estimator divides by another l. Planar points must stay planar with a margin of this factor.
+constexpr double kNoiseFloorFactor = 4.0;
+/// Largest neighbourhood (vertices) gathered for one vertex: bounds the work on degenerate
+/// input (a fan of thousands of slivers) without touching any sensible mesh.
+constexpr std::size_t kMaxNeighbourhood = 512;
+/// The kernel neighbourhood is bounded by its radius; this only caps the search.
+constexpr int kMaxRings = 64;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+/// At most this many edges are sampled (evenly) for the median edge length.
+constexpr std::size_t kMedianSample = 1 << 20;
+
+/// Symmetric 3x3 tensor: xx, xy, xz, yy, yz, zz.
+struct Sym3 {
+    double v[6] = {0, 0, 0, 0, 0, 0};
+    void add_outer(Vec3 e, double w) {
+        v[0] += w * e.x * e.x;
+        v[1] += w * e.x * e.y;
+        v[2] += w * e.x * e.z;
+        v[3] += w * e.y * e.y;
+        v[4] += w * e.y * e.z;
+        v[5] += w * e.z * e.z;
+    }
+    void add(const Sym3& o, double weight = 1.0) {
+        for (int i = 0; i < 6; ++i) v[i] += weight * o.v[i];
+    }
+    double frobenius() const {
+        return std::sqrt(v[0] * v[0] + v[3] * v[3] + v[5] * v[5] +
+                         2 * (v[1] * v[1] + v[2] * v[2] + v[4] * v[4]));
+    }
+    /// Adds R S R^T for the smallest rotation R that turns unit vector `from` into unit
+    /// vector `to` (Rodrigues: R = I + [u]x + [u]x^2 / (1 + c), u = from x to, c = from . to).
+    void add_rotated(const Sym3& s, Vec3 from, Vec3 to, double weight = 1.0) {
+        const Vec3 u = cross(from, to);
+        const double c = dot(from, to);
+        if (c <= -0.999) return;  // opposite normals: a fold, nothing sensible to transport
+        const double k = 1.0 / (1.0 + c);
+        const double r[3][3] = {{c + k * u.x * u.x, k * u.x * u.y - u.z, k * u.x * u.z + u.y},
+                                {k * u.y * u.x + u.z, c + k * u.y * u.y, k * u.y * u.z - u.x},
+                                {k * u.z * u.x - u.y, k * u.z * u.y + u.x, c + k * u.z * u.z}};
+        const double m[3][3] = {
+            {s.v[0], s.v[1], s.v[2]}, {s.v[1], s.v[3], s.v[4]}, {s.v[2], s.v[4], s.v[5]}};
+        double rm[3][3];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                rm[i][j] = r[i][0] * m[0][j] + r[i][1] * m[1][j] + r[i][2] * m[2][j];
+        auto out = [&](int i, int j) {
+            return rm[i][0] * r[j][0] + rm[i][1] * r[j][1] + rm[i][2] * r[j][2];
+        };
+        v[0] += weight * out(0, 0);
+        v[1] += weight * out(0, 1);
+        v[2] += weight * out(0, 2);
+        v[3] += weight * out(1, 1);
+        v[4] += weight * out(1, 2);
+        v[5] += weight * out(2, 2);
+    }
+    /// a^T S b.
+    double form(Vec3 a, Vec3 b) const {
+        return a.x * (v[0] * b.x + v[1] * b.y + v[2] * b.z) +
+               a.y * (v[1] * b.x + v[3] * b.y + v[4] * b.z) +
+               a.z * (v[2] * b.x + v[4] * b.y + v[5] * b.z);
+    }
+};
+
+/// What the first pass knows of a vertex.
+struct VertexData {
+    Sym3 tensor;           ///< sum over incident edges of beta |e|/2 e e^T
+    Vec3 normal;           ///< unit, angle-weighted
+    double area = 0;       ///< mixed Voronoi cell area
+    double max_turn = 0;   ///< largest |dihedral angle| of an incident edge
+    double mean_edge = 0;  ///< mean length of incident edges
+    double min_edge = 0;   ///< shortest incident edge
+    double max_edge = 0;   ///< longest incident edge
+};
+
+/// An orthonormal tangent basis of unit normal n (Duff et al., "Building an orthonormal basis,
+/// revisited", 2017): continuous except across n.z = 0, which is fine for a projection.
+void tangent_basis(Vec3 n, Vec3& t1, Vec3& t2) {
+    const double sign = std::copysign(1.0, n.z);
+    const double a = -1.0 / (sign + n.z);
+    const double b = n.x * n.y * a;
+    t1 = {1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x};
+    t2 = {b, sign + n.y * n.y * a, -n.y};
+}
+
+/// Calls f(h) for every outgoing half-edge of v (the whole fan, open or closed).
+template <class F>
+void for_each_outgoing(const Mesh& m, VertexId v, F&& f) {
+    const HalfedgeId h0 = m.outgoing(v);
+    if (!h0.is_valid()) return;
+    HalfedgeId h = h0;
+    do {
+        f(h);
+        const HalfedgeId t = m.twin(Mesh::prev(h));
+        if (!t.is_valid()) break;
+        h = t;
+    } while (h != h0);
+}
+
+/// The mixed Voronoi share of corner i of the triangle p[0..2] (see mixed_voronoi_areas()).
+double mixed_share(const Vec3 p[3], int i) {
+    const double area2 = norm(cross(p[1] - p[0], p[2] - p[0]));
+    if (area2 <= 0) return 0;
+    double d[3];
+    int obtuse = -1;
+    for (int k = 0; k < 3; ++k) {
+        d[k] = dot(p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+        if (d[k] < 0) obtuse = k;
+    }
+    if (obtuse >= 0) return 0.5 * area2 * (i == obtuse ? 0.5 : 0.25);
+    // (|e_ij|^2 cot(k) + |e_ik|^2 cot(j)) / 8 with cot = dot / |cross| = dot / area2.
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    const Vec3 eij = p[j] - p[i], eik = p[k] - p[i];
+    return (dot(eij, eij) * d[k] + dot(eik, eik) * d[j]) / (8.0 * area2);
+}
+
+VertexData first_pass(const Mesh& m, const FaceMap<Vec3>& face_normal, VertexId v) {
+    VertexData out;
+    const Vec3 pv = m.position(v);
+    Vec3 normal{};
+    double edge_sum = 0;
+    int edges = 0;
+    for_each_outgoing(m, v, [&](HalfedgeId h) {
+        const FaceId f = Mesh::face(h);
+        const Vec3 p[3] = {pv, m.position(m.target(h)), m.position(m.origin(Mesh::prev(h)))};
+        const Vec3 u = p[1] - p[0], w = p[2] - p[0];
+        const double lu = norm(u), lw = norm(w);
+        if (lu > 0 && lw > 0) {
+            const double angle = std::acos(std::clamp(dot(u, w) / (lu * lw), -1.0, 1.0));
+            normal += angle * face_normal[f];
+        }
+        out.area += mixed_share(p, 0);
+        edge_sum += lu;
+        ++edges;
+        if (lu > 0 && (out.min_edge == 0 || lu < out.min_edge)) out.min_edge = lu;
+        out.max_edge = std::max(out.max_edge, lu);
+        const HalfedgeId t = m.twin(h);
+        if (!t.is_valid() || lu <= 0) return;
+        const Vec3 n1 = face_normal[f], n2 = face_normal[Mesh::face(t)];
+        const Vec3 e = u / lu;
+        const double beta = std::atan2(dot(cross(n1, n2), e), std::clamp(dot(n1, n2), -1.0, 1.0));
+        out.tensor.add_outer(e, beta * 0.5 * lu);
+        out.max_turn = std::max(out.max_turn, std::fabs(beta));
+    });
+    // The last edge of an open fan has no outgoing half-edge from v: count its length too.
+    const HalfedgeId h0 = m.outgoing(v);
+    if (h0.is_valid() && !m.twin(h0).is_valid()) {
+        // h0 is the boundary one; the other boundary edge ends at v in the fan's last face.
+        HalfedgeId last = h0;
+        for_each_outgoing(m, v, [&](HalfedgeId g) { last = g; });
+        const double l = norm(m.position(m.origin(Mesh::prev(last))) - pv);
+        edge_sum += l;
+        out.max_edge = std::max(out.max_edge, l);
+        ++edges;
+    }
+    out.normal = normalized(normal);
+    out.mean_edge = edges > 0 ? edge_sum / edges : 0;
+    return out;
+}
+
+/// Reusable per-thread buffers of the neighbourhood search.
+struct Scratch {
+    std::vector<std::uint32_t> set;  ///< vertices of the neighbourhood, p first
+    std::vector<std::pair<double, std::uint32_t>> heap;
+    /// stamp[v] == current: v is in `set` (O(1) membership without clearing per vertex).
+    std::vector<std::uint32_t> stamp;
+    std::uint32_t current = 0;
+
+    void begin(std::size_t num_vertices) {
+        if (stamp.size() != num_vertices) stamp.assign(num_vertices, 0);
+        if (++current == 0) {
+            std::fill(stamp.begin(), stamp.end(), 0);
+            current = 1;
+        }
+        set.clear();
+    }
+    bool contains(std::uint32_t v) const { return stamp[v] == current; }
+    void insert(std::uint32_t v) {
+        stamp[v] = current;
+        set.push_back(v);
+    }
+};
+
+/// Calls f(w) for every neighbour w of v (once each on a manifold fan).
+template <class F>
+void for_each_neighbour(const Mesh& m, VertexId v, F&& f) {
+    const HalfedgeId h0 = m.outgoing(v);
+    if (!h0.is_valid()) return;
+    HalfedgeId h = h0;
+    do {
+        f(m.target(h));
+        const HalfedgeId p = Mesh::prev(h);
+        const HalfedgeId t = m.twin(p);
+        if (!t.is_valid()) {
+            f(m.origin(p));  // the far end of an open fan
+            return;
+        }
+        h = t;
+    } while (h != h0);
+}
+
+/// The vertices fewer than `rings` edges from p, reached through vertices within `radius` of p
+/// that are not on sharp edges. With `local_cells`, also only vertices whose cell lies within the
+/// radius (no incident edge longer than it): the cell of a vertex on the border of a CAD face
+/// reaches across the long triangles of its neighbour face, whose area must not dilute p's.
+void ring_neighbourhood(const Mesh& m, const std::vector<VertexData>& data, double sharp,
+                        VertexId p, int rings, double radius, bool local_cells, Scratch& s) {
+    s.begin(m.num_vertices());
+    s.insert(p.idx());
+    const Vec3 pp = m.position(p);
+    const double r2 = radius * radius;
+    std::size_t level_begin = 0;
+    for (int level = 1; level < rings; ++level) {
+        const std::size_t level_end = s.set.size();
+        for (std::size_t i = level_begin; i < level_end && s.set.size() < kMaxNeighbourhood; ++i) {
+            for_each_neighbour(m, VertexId(s.set[i]), [&](VertexId w) {
+                const VertexData& dw = data[w.idx()];
+                if (s.contains(w.idx()) || dw.max_turn >= sharp) return;
+                if (local_cells && dw.max_edge >= radius) return;
+                const Vec3 d = m.position(w) - pp;
+                if (dot(d, d) >= r2) return;
+                s.insert(w.idx());
+            });
+        }
+        if (s.set.size() == level_end) break;
+        level_begin = level_end;
+    }
+}
+
+void geodesic_neighbourhood(const Mesh& m, const std::vector<VertexData>& data, double sharp,
+                            VertexId p, double radius, Scratch& s) {
+    s.begin(m.num_vertices());
+    s.heap.clear();
+    // Dijkstra along edges, bounded by the radius; `set` holds the settled vertices.
+    auto cmp = [](const auto& a, const auto& b) { return a > b; };
+    s.heap.emplace_back(0.0, p.idx());
+    while (!s.heap.empty() && s.set.size() < kMaxNeighbourhood) {
+        std::pop_heap(s.heap.begin(), s.heap.end(), cmp);
+        const double d = s.heap.back().first;
+        const std::uint32_t v = s.heap.back().second;
+        s.heap.pop_back();
+        if (s.contains(v)) continue;
+        s.insert(v);
+        const Vec3 pq = m.position(VertexId(v));
+        for_each_neighbour(m, VertexId(v), [&](VertexId w) {
+            if (s.contains(w.idx()) || data[w.idx()].max_turn >= sharp) return;
+            const double dw = d + norm(m.position(w) - pq);
+            if (dw >= radius) return;
+            s.heap.emplace_back(dw, w.idx());
+            std::push_heap(s.heap.begin(), s.heap.end(), cmp);
+        });
+    }
+}
+
+/// The weighted tensor of method.md 3.1 over the cells in s.set, relative to p's normal.
+Sym3 weighted_tensor(const Mesh& m, const FaceMap<Vec3>& face_normal, Vec3 np, const Scratch& s) {
+    Sym3 sum;
+    double lambda_sum = 0;
+    std::size_t count = 0;
+    for (const std::uint32_t qi : s.set) {
+        const VertexId q(qi);
+        const Vec3 pq = m.position(q);
+        for_each_outgoing(m, q, [&](HalfedgeId h) {
+            const HalfedgeId t = m.twin(h);
+            if (!t.is_valid()) return;
+            const Vec3 u = m.position(m.target(h)) - pq;
+            const double lu = norm(u);
+            if (lu <= 0) return;
+            const Vec3 n1 = face_normal[Mesh::face(h)], n2 = face_normal[Mesh::face(t)];
+            const Vec3 e = u / lu;
+            const double beta =
+                std::atan2(dot(cross(n1, n2), e), std::clamp(dot(n1, n2), -1.0, 1.0));
+            const double lambda = std::acos(std::clamp(dot(np, normalized(n1 + n2)), -1.0, 1.0));
+            sum.add_outer(e, lambda * beta * 0.5 * lu);
+            lambda_sum += lambda;
+            ++count;
+        });
+    }
+    if (lambda_sum <= 0) {
+        // Every edge normal parallel to the vertex normal: all weights equal, i.e. 1.
+        Sym3 plain;
+        for (const std::uint32_t qi : s.set) {
+            const VertexId q(qi);
+            const Vec3 pq = m.position(q);
+            for_each_outgoing(m, q, [&](HalfedgeId h) {
+                const HalfedgeId t = m.twin(h);
+                if (!t.is_valid()) return;
+                const Vec3 u = m.position(m.target(h)) - pq;
+                const double lu = norm(u);
+                if (lu <= 0) return;
+                const Vec3 n1 = face_normal[Mesh::face(h)], n2 = face_normal[Mesh::face(t)];
+                const double beta =
+                    std::atan2(dot(cross(n1, n2), u / lu), std::clamp(dot(n1, n2), -1.0, 1.0));
+                plain.add_outer(u / lu, beta * 0.5 * lu);
+            });
+        }
+        return plain;
+    }
+    // Rescale so that the weights average 1 over the edges (method.md 3.1).
+    const double scale = static_cast<double>(count) / lambda_sum;
+    for (double& x : sum.v) x *= scale;
+    return sum;
+}
+
+double median_edge_length(const Mesh& m) {
+    const std::size_t nh = m.num_halfedges();
+    const std::size_t stride = std::max<std::size_t>(1, nh / kMedianSample);
+    std::vector<double> lengths;
+    lengths.reserve(nh / stride + 1);
+    for (std::size_t i = 0; i < nh; i += stride) {
+        const HalfedgeId h(static_cast<std::uint32_t>(i));
+        lengths.push_back(norm(m.position(m.target(h)) - m.position(m.origin(h))));
+    }
+    if (lengths.empty()) return 0;
+    auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+    std::nth_element(lengths.begin(), mid, lengths.end());
+    return *mid;
+}
+
+/// The rounding unit of the coordinates: float32's when every coordinate is a float (binary
+/// STL, or text written from floats), else double's.
+double coordinate_precision(const Mesh& m, double max_abs) {
+    bool all_float = true;
+    for (const Vec3& p : m.positions()) {
+        for (int i = 0; i < 3; ++i) {
+            if (static_cast<double>(static_cast<float>(p[i])) != p[i]) {
+                all_float = false;
+                break;
+            }
+        }
+        if (!all_float) break;
+    }
+    return max_abs * (all_float ? 0x1.0p-24 : 0x1.0p-53);
+}
+
+std::string format_number(double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", x);
+    return buf;
+}
+
+}  // namespace
+
+CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options) {
+    CurvatureResult result;
+    CurvatureThresholds& th = result.thresholds;
+    const std::size_t nv = m.num_vertices(), nf = m.num_faces();
+    const int rings = std::max(1, options.rings);
+    const double kernel_edges =
+        options.kernel_edges > 0 ? options.kernel_edges : kDefaultKernelEdges;
+    const double kernel_angle =
+        options.kernel_angle > 0 ? options.kernel_angle : kDefaultKernelAngle;
+    th.estimator = options.estimator;
+    th.sharp_edge_angle =
+        options.sharp_edge_angle >= 0 ? options.sharp_edge_angle : kDefaultSharpEdgeAngle;
+    switch (options.neighbourhood) {
+        case Neighbourhood::kKernel:
+            th.neighbourhood = "kernel: radius min(" + format_number(kernel_edges) +
+                               " x shortest incident edge, " + format_number(kernel_angle) +
+                               " / 1-ring curvature)";
+            break;
+        case Neighbourhood::kRings:
+            th.neighbourhood = std::to_string(rings) + "-ring";
+            break;
+        case Neighbourhood::kGeodesic:
+            th.neighbourhood = "geodesic radius " + format_number(options.radius);
+            break;
+    }
+
+    // Face normals, then everything a vertex knows of its own fan.
+    FaceMap<Vec3> face_normal(nf);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf), [&](const auto& r) {
+        for (std::size_t f = r.begin(); f != r.end(); ++f) {
+            const FaceId ff(static_cast<std::uint32_t>(f));
+            face_normal[ff] = m.face_normal(ff);
+        }
+    });
+    std::vector<VertexData> data(nv);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
+        for (std::size_t v = r.begin(); v != r.end(); ++v)
+            data[v] = first_pass(m, face_normal, VertexId(static_cast<std::uint32_t>(v)));
+    });
+
+    // Thresholds from the model's size and the mesh's resolution.
+    Box3 box;
+    double max_abs = 0;
+    for (const Vec3& p : m.positions()) {
+        box.add(p);
+        max_abs = std::max({max_abs, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    }
+    const double diagonal = box.empty() ? 0.0 : norm(box.max - box.min);
+    th.median_edge_length = median_edge_length(m);
+    th.coordinate_precision = coordinate_precision(m, max_abs);
+    if (options.planar_curvedness >= 0) {
+        th.planar_curvedness = options.planar_curvedness;
+        th.planar_rule = "given";
+    } else {
+        const double by_size = diagonal > 0 ? 1.0 / (kPlanarRadiusFactor * diagonal) : 0.0;
+        const double l = th.median_edge_length;
+        const double by_noise = l > 0 ? kNoiseFloorFactor * th.coordinate_precision / (l * l) : 0;
+        th.planar_curvedness = std::max(by_size, by_noise);
+        th.planar_rule = by_size >= by_noise
+                             ? "1 / (100 x bounding-box diagonal): radii beyond 100 times the "
+                               "part's size are planes"
+                             : "4 x coordinate precision / median edge length^2: the noise "
+                               "floor of the rounded coordinates";
+    }
+    th.high_rule =
+        "an incident edge turns by at least the sharp-edge angle, or the curvedness exceeds "
+        "the sharp-edge angle / the mean length of the incident edges";
+
+    CurvatureField& out = result.field;
+    out.k1 = VertexMap<double>(nv);
+    out.k2 = VertexMap<double>(nv);
+    out.dir1 = VertexMap<Vec3>(nv);
+    out.dir2 = VertexMap<Vec3>(nv);
+    out.normal = VertexMap<Vec3>(nv);
+    out.shape_index = VertexMap<double>(nv);
+    out.curvedness = VertexMap<double>(nv);
+    out.type = VertexMap<ShapeType>(nv, ShapeType::kPlane);
+    out.high = VertexMap<std::uint8_t>(nv, 0);
+
+    const double sharp = th.sharp_edge_angle;
+    const double planar = th.planar_curvedness;
+    tbb::enumerable_thread_specific<Scratch> scratch;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
+        Scratch& s = scratch.local();
+        for (std::size_t vi = r.begin(); vi != r.end(); ++vi) {
+            const VertexId p(static_cast<std::uint32_t>(vi));
+            const VertexData& d = data[vi];
+            const Vec3 n = d.normal;
+            out.normal[p] = n;
+            double kernel_radius = 0;  // 0: every cell of the neighbourhood weighs 1
+            switch (options.neighbourhood) {
+                case Neighbourhood::kKernel: {
+                    const double kf = d.area > 0 ? d.tensor.frobenius() / d.area : 0;
+                    kernel_radius = kernel_edges * d.min_edge;
+                    if (kf > 0) kernel_radius = std::min(kernel_radius, kernel_angle / kf);
+                    ring_neighbourhood(m, data, sharp, p, kMaxRings, kernel_radius, true, s);
+                    break;
+                }
+                case Neighbourhood::kRings:
+                    ring_neighbourhood(m, data, sharp, p, rings, kInfinity, false, s);
+                    break;
+                case Neighbourhood::kGeodesic:
+                    geodesic_neighbourhood(m, data, sharp, p, options.radius, s);
+                    break;
+            }
+            double area = 0;
+            Sym3 w;
+            if (options.estimator == CurvatureEstimator::kWeighted) {
+                for (const std::uint32_t q : s.set) area += data[q].area;
+                w = weighted_tensor(m, face_normal, n, s);
+            } else {
+                const Vec3 pp = m.position(p);
+                for (const std::uint32_t q : s.set) {
+                    if (q == p.idx()) {
+                        area += d.area;
+                        w.add(d.tensor);
+                        continue;
+                    }
+                    double kw = 1.0;
+                    if (kernel_radius > 0) {
+                        const Vec3 dq = m.position(VertexId(q)) - pp;
+                        const double t = dot(dq, dq) / (kernel_radius * kernel_radius);
+                        kw = (1 - t) * (1 - t);
+                    }
+                    area += kw * data[q].area;
+                    if (options.transport) {
+                        w.add_rotated(data[q].tensor, data[q].normal, n, kw);
+                    } else {
+                        w.add(data[q].tensor, kw);
+                    }
+                }
+            }
+            double k1 = 0, k2 = 0;
+            Vec3 t1{}, t2{};
+            if (area > 0 && norm(n) > 0) {
+                tangent_basis(n, t1, t2);
+                const double a = w.form(t1, t1) / area, b = w.form(t1, t2) / area,
+                             c = w.form(t2, t2) / area;
+                const double mean = 0.5 * (a + c);
+                const double radius = std::hypot(0.5 * (a - c), b);
+                const double mu1 = mean + radius, mu2 = mean - radius;
+                const double theta = 0.5 * std::atan2(2.0 * b, a - c);
+                const Vec3 e1 = std::cos(theta) * t1 + std::sin(theta) * t2;  // of mu1
+                // The eigenvector of an eigenvalue is the direction of the other curvature.
+                k1 = mu1;
+                k2 = mu2;
+                out.dir1[p] = cross(n, e1);
+                out.dir2[p] = e1;
+            }
+            out.k1[p] = k1;
+            out.k2[p] = k2;
+            const double c = curvedness(k1, k2);
+            out.curvedness[p] = c;
+            const ShapeType type = classify_shape(k1, k2, planar);
+            out.type[p] = type;
+            out.shape_index[p] = type == ShapeType::kPlane ? 2.0 : shape_index(k1, k2);
+            const bool high = d.max_turn >= sharp || (d.mean_edge > 0 && c * d.mean_edge >= sharp);
+            out.high[p] = high ? 1 : 0;
+        }
+    });
+    for (std::size_t v = 0; v < nv; ++v) {
+        ++result.count_by_type[static_cast<int>(out.type.data()[v])];
+        result.high_points += out.high.data()[v];
+    }
+    return result;
+}
+
+}  // namespace ncrev
