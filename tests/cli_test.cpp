@@ -6,9 +6,11 @@
 
 #include <array>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "ncrev/curvature.h"
 #include "ncrev/io.h"
 #include "test_meshes.h"
 
@@ -162,6 +164,93 @@ TEST(CliReverse, OpenMeshWithRequireSolidExitsThreeAndWritesNothing) {
     EXPECT_NE(shell.err.find("warning: the mesh is open"), std::string::npos) << shell.err;
     std::filesystem::remove(step);
     std::filesystem::remove(stl);
+}
+
+/// The vertex records of a PLY written by `ncrev curvature`, after checking its header.
+struct CurvatureVertex {
+    float x, y, z, k1, k2, shape_index, curvedness;
+    std::uint8_t type, high, red, green, blue;
+};
+std::vector<CurvatureVertex> read_curvature_ply(const std::filesystem::path& path) {
+    std::ifstream f(path, std::ios::binary);
+    std::string text((std::istreambuf_iterator<char>(f)), {});
+    const std::size_t end = text.find("end_header\n");
+    EXPECT_NE(end, std::string::npos);
+    const std::string header = text.substr(0, end);
+    const std::string want =
+        "property float x\nproperty float y\nproperty float z\nproperty float k1\n"
+        "property float k2\nproperty float shape_index\nproperty float curvedness\n"
+        "property uchar type\nproperty uchar high\nproperty uchar red\nproperty uchar green\n"
+        "property uchar blue\nelement face ";
+    EXPECT_NE(header.find(want), std::string::npos) << header;
+    EXPECT_NE(header.find("format binary_little_endian 1.0"), std::string::npos);
+    const std::size_t at = header.find("element vertex ");
+    const std::size_t n = std::stoul(header.substr(at + 15));
+    std::vector<CurvatureVertex> v(n);
+    const char* p = text.data() + end + 11;
+    EXPECT_GE(text.size() - (end + 11), n * 33);
+    for (std::size_t i = 0; i < n && text.size() - (end + 11) >= n * 33; ++i, p += 33) {
+        std::memcpy(&v[i], p, 28);
+        std::memcpy(&v[i].type, p + 28, 5);
+    }
+    return v;
+}
+
+TEST(CliCurvature, WritesTheTypedPlyAndOneJsonDocument) {
+    const auto m = test::icosphere(5.0, 5);
+    const auto in = write_temp("ncrev_cli_sphere.stl", encode_stl_binary(m.points, m.triangles));
+    const auto out = std::filesystem::temp_directory_path() / "ncrev_cli_sphere.ply";
+    std::filesystem::remove(out);
+    const CliRun r = run("curvature " + in.string() + " -o " + out.string() + " --json -q");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    const auto& c = j["curvature"];
+    EXPECT_EQ(c["estimator"], "plain");
+    EXPECT_GT(c["thresholds"]["planar_curvedness"].get<double>(), 0.0);
+    EXPECT_EQ(c["thresholds"]["sharp_edge_angle"], kDefaultSharpEdgeAngle);
+    std::uint64_t total = 0;
+    for (const auto& [name, n] : c["vertices_by_type"].items()) total += n.get<std::uint64_t>();
+    EXPECT_EQ(total, j["mesh"]["vertices"].get<std::uint64_t>());
+    EXPECT_EQ(c["vertices_by_type"]["cap"].get<std::uint64_t>(), total);
+    const auto v = read_curvature_ply(out);
+    ASSERT_EQ(v.size(), total);
+    for (const CurvatureVertex& x : v) {
+        EXPECT_EQ(x.type, 9);
+        EXPECT_EQ(x.high, 0);
+        EXPECT_NEAR(x.k1, 0.2, 0.01);
+        EXPECT_NEAR(x.k2, 0.2, 0.01);
+        EXPECT_NEAR(x.shape_index, 1.0, 0.05);
+        EXPECT_EQ(x.red, 220);  // the color of "cap"
+    }
+    // Without --json: a text summary, and the same PLY.
+    const CliRun t = run("curvature " + in.string() + " -o " + out.string() + " -q");
+    ASSERT_EQ(t.code, 0) << t.err;
+    EXPECT_NE(t.out.find("types: plane 0"), std::string::npos) << t.out;
+}
+
+TEST(CliCurvature, BadInputAndUsageErrorsWriteNothing) {
+    const auto out = std::filesystem::temp_directory_path() / "ncrev_cli_bad.ply";
+    std::filesystem::remove(out);
+    const auto bad =
+        write_temp("ncrev_cli_bad.stl", test::bytes_of("solid x\n facet normal 0 0 1\n"));
+    const CliRun r = run("curvature " + bad.string() + " -o " + out.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(r.out.empty());
+    EXPECT_NE(r.err.find(bad.string()), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out));
+    const auto m = test::cube();
+    const auto in = write_temp("ncrev_cli_cube_c.stl", encode_stl_binary(m.points, m.triangles));
+    EXPECT_EQ(run("curvature " + in.string() + " -o " + in.string()).code, 1);
+    EXPECT_EQ(
+        run("curvature " + in.string() + " -o " + out.string() + " --neighbourhood geodesic").code,
+        1);
+    EXPECT_EQ(run("curvature " + in.string() + " -o " + out.string() + " --estimator fancy").code,
+              1);
+    EXPECT_FALSE(std::filesystem::exists(out));
+    // The cube's corners and edges are all high-curvature points.
+    const CliRun ok = run("curvature " + in.string() + " -o " + out.string() + " --json -q");
+    ASSERT_EQ(ok.code, 0) << ok.err;
+    EXPECT_EQ(nlohmann::json::parse(ok.out)["curvature"]["high_points"], 8);
 }
 
 }  // namespace

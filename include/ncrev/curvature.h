@@ -12,8 +12,10 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "ncrev/common.h"
 #include "ncrev/mesh.h"
@@ -163,5 +165,10 @@ struct CurvatureResult {
 /// the same bits whatever the thread count. Never fails: options out of range are clamped
 /// (rings to >= 1).
 CurvatureResult compute_curvature(const Mesh& mesh, const CurvatureOptions& options = {});
+
+/// The PLY of `ncrev curvature`: binary little-endian; vertex properties x y z k1 k2
+/// shape_index curvedness (float), type high red green blue (uchar; the color of the type, see
+/// shape_type_color()); the faces as vertex_indices. Vertices and faces in the mesh's order.
+std::vector<std::byte> encode_curvature_ply(const Mesh& mesh, const CurvatureResult& result);
 
 }  // namespace ncrev

@@ -7,6 +7,7 @@
 
 #include "ncrev/brep.h"
 #include "ncrev/common.h"
+#include "ncrev/curvature.h"
 #include "ncrev/io.h"
 #include "ncrev/mesh.h"
 
@@ -49,6 +50,14 @@ std::string to_json(const InfoReport& report, int indent = 2);
 /// faces by surface kind, faces, edges, vertices, solid, valid, volumes and areas of the mesh
 /// and of the solid, STEP bytes); warnings of both.
 std::string to_json(const InfoReport& info, const ReverseReport& reverse, int indent = 2);
+
+/// The report of `ncrev curvature`: the info keys plus "curvature" (estimator, neighbourhood,
+/// thresholds with their rules, vertices per type, high-curvature points, seconds).
+std::string to_json(const InfoReport& info, const CurvatureResult& curvature, double seconds,
+                    int indent = 2);
+
+/// The curvature summary as a few lines of text: vertices per type, thresholds.
+std::string to_text(const CurvatureResult& curvature, Unit unit);
 
 /// The report as a few lines of text for a terminal.
 std::string to_text(const InfoReport& report);

@@ -24,6 +24,8 @@
 #include <utility>
 #include <vector>
 
+#include "ncrev/io.h"
+
 namespace ncrev {
 
 const char* to_string(CurvatureEstimator estimator) {
@@ -611,6 +613,36 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
         result.high_points += out.high.data()[v];
     }
     return result;
+}
+
+std::vector<std::byte> encode_curvature_ply(const Mesh& m, const CurvatureResult& result) {
+    const std::size_t nv = m.num_vertices(), nf = m.num_faces();
+    std::vector<std::array<std::uint32_t, 3>> triangles(nf);
+    for (std::size_t f = 0; f < nf; ++f) {
+        const FaceId ff(static_cast<std::uint32_t>(f));
+        triangles[f] = {m.vertex(ff, 0).idx(), m.vertex(ff, 1).idx(), m.vertex(ff, 2).idx()};
+    }
+    using Type = PlyColumn::Type;
+    std::vector<PlyColumn> columns = {
+        {"k1", Type::kFloat32, {}},          {"k2", Type::kFloat32, {}},
+        {"shape_index", Type::kFloat32, {}}, {"curvedness", Type::kFloat32, {}},
+        {"type", Type::kUint8, {}},          {"high", Type::kUint8, {}},
+        {"red", Type::kUint8, {}},           {"green", Type::kUint8, {}},
+        {"blue", Type::kUint8, {}}};
+    for (PlyColumn& c : columns) c.values.resize(nv);
+    const CurvatureField& f = result.field;
+    for (std::size_t i = 0; i < nv; ++i) {
+        const VertexId v(static_cast<std::uint32_t>(i));
+        const auto rgb = shape_type_color(f.type[v]);
+        columns[0].values[i] = f.k1[v];
+        columns[1].values[i] = f.k2[v];
+        columns[2].values[i] = f.shape_index[v];
+        columns[3].values[i] = f.curvedness[v];
+        columns[4].values[i] = static_cast<double>(f.type[v]);
+        columns[5].values[i] = f.high[v];
+        for (int k = 0; k < 3; ++k) columns[6 + k].values[i] = rgb[k];
+    }
+    return encode_ply(m.positions(), triangles, columns);
 }
 
 }  // namespace ncrev

@@ -169,6 +169,66 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
     return j.dump(indent);
 }
 
+namespace {
+
+nlohmann::json curvature_json(const CurvatureResult& c, double seconds) {
+    using nlohmann::json;
+    const CurvatureThresholds& t = c.thresholds;
+    json by_type = json::object();
+    for (int i = 0; i < kNumShapeTypes; ++i) {
+        by_type[to_string(static_cast<ShapeType>(i))] =
+            c.count_by_type[static_cast<std::size_t>(i)];
+    }
+    return {{"estimator", to_string(t.estimator)},
+            {"neighbourhood", t.neighbourhood},
+            {"thresholds",
+             {{"planar_curvedness", t.planar_curvedness},
+              {"planar_rule", t.planar_rule},
+              {"sharp_edge_angle", t.sharp_edge_angle},
+              {"high_rule", t.high_rule},
+              {"median_edge_length", t.median_edge_length},
+              {"coordinate_precision", t.coordinate_precision}}},
+            {"vertices_by_type", by_type},
+            {"high_points", c.high_points},
+            {"seconds", seconds}};
+}
+
+}  // namespace
+
+std::string to_json(const InfoReport& info, const CurvatureResult& curvature, double seconds,
+                    int indent) {
+    nlohmann::json j = info_json(info);
+    j["curvature"] = curvature_json(curvature, seconds);
+    return j.dump(indent);
+}
+
+std::string to_text(const CurvatureResult& c, Unit unit) {
+    const char* u = to_string(unit);
+    std::uint64_t total = 0;
+    for (const std::uint64_t n : c.count_by_type) total += n;
+    std::string s;
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "curvature: %s estimator, %s\n",
+                  to_string(c.thresholds.estimator), c.thresholds.neighbourhood.c_str());
+    s += buf;
+    std::snprintf(buf, sizeof buf,
+                  "thresholds: planar below curvedness %.4g 1/%s; sharp edges from %.3g rad\n",
+                  c.thresholds.planar_curvedness, u, c.thresholds.sharp_edge_angle);
+    s += buf;
+    s += "types:";
+    for (int i = 0; i < kNumShapeTypes; ++i) {
+        const std::uint64_t n = c.count_by_type[static_cast<std::size_t>(i)];
+        std::snprintf(buf, sizeof buf, " %s %llu (%.1f %%)%s", to_string(static_cast<ShapeType>(i)),
+                      static_cast<unsigned long long>(n), total ? 100.0 * n / total : 0.0,
+                      i + 1 < kNumShapeTypes ? "," : "\n");
+        s += buf;
+    }
+    std::snprintf(buf, sizeof buf, "high-curvature points: %llu\n",
+                  static_cast<unsigned long long>(c.high_points));
+    s += buf;
+    return s;
+}
+
 std::string to_text(const InfoReport& r) {
     char buf[512];
     std::string s;
