@@ -522,10 +522,15 @@ std::vector<std::pair<std::string, CurvatureOptions>> study_variants() {
     untransported.rings = 3;
     untransported.transport = false;
     v.emplace_back("plain 3-ring, not transported", untransported);
-    CurvatureOptions narrow;
-    narrow.kernel_edges = 2.5;
-    v.emplace_back("plain kernel 2.5 edges", narrow);
-    v.emplace_back("plain kernel (default)", CurvatureOptions{});
+    CurvatureOptions kernel;
+    kernel.neighbourhood = Neighbourhood::kKernel;
+    v.emplace_back("plain kernel", kernel);
+    for (int passes : {2, 3, 4}) {
+        CurvatureOptions sm;
+        sm.neighbourhood = Neighbourhood::kSmoothed;
+        sm.passes = passes;
+        v.emplace_back("plain smoothed " + std::to_string(passes), sm);
+    }
     return v;
 }
 

@@ -81,6 +81,12 @@ enum class Neighbourhood {
     /// The union of the cells of the vertices whose shortest path along edges from p is
     /// shorter than `radius`, all of weight 1.
     kGeodesic,
+    /// `passes` rounds in which every vertex adds to its own tensor and area those of its
+    /// neighbours (each tensor transported to its tangent plane): after n rounds, the cells
+    /// within n rings weighted by the number of paths that reach them, a bell-shaped kernel
+    /// close to kKernel's at a fraction of its cost. A neighbour takes part only when it is
+    /// not on a sharp edge and it and its whole cell lie within the kernel radius of kKernel.
+    kSmoothed,
 };
 /// "kernel", "rings", "geodesic".
 const char* to_string(Neighbourhood neighbourhood);
@@ -102,6 +108,8 @@ struct CurvatureOptions {
     int rings = 1;
     /// kGeodesic: the radius in model units, > 0.
     double radius = 0;
+    /// kSmoothed: the number of rounds, >= 1.
+    int passes = 3;
     /// kKernel: see Neighbourhood::kKernel; <= 0 selects the default.
     double kernel_edges = kDefaultKernelEdges;
     double kernel_angle = kDefaultKernelAngle;

@@ -40,6 +40,8 @@ const char* to_string(Neighbourhood neighbourhood) {
             return "rings";
         case Neighbourhood::kGeodesic:
             return "geodesic";
+        case Neighbourhood::kSmoothed:
+            return "smoothed";
     }
     return "unknown";
 }
@@ -204,21 +206,43 @@ void for_each_outgoing(const Mesh& m, VertexId v, F&& f) {
     } while (h != h0);
 }
 
-/// The mixed Voronoi share of corner i of the triangle p[0..2] (see mixed_voronoi_areas()).
-double mixed_share(const Vec3 p[3], int i) {
-    const double area2 = norm(cross(p[1] - p[0], p[2] - p[0]));
-    if (area2 <= 0) return 0;
-    double d[3];
-    int obtuse = -1;
-    for (int k = 0; k < 3; ++k) {
-        d[k] = dot(p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
-        if (d[k] < 0) obtuse = k;
-    }
-    if (obtuse >= 0) return 0.5 * area2 * (i == obtuse ? 0.5 : 0.25);
-    // (|e_ij|^2 cot(k) + |e_ik|^2 cot(j)) / 8 with cot = dot / |cross| = dot / area2.
-    const int j = (i + 1) % 3, k = (i + 2) % 3;
-    const Vec3 eij = p[j] - p[i], eik = p[k] - p[i];
-    return (dot(eij, eij) * d[k] + dot(eik, eik) * d[j]) / (8.0 * area2);
+/// acos to within 2e-8 rad (Abramowitz and Stegun 4.4.46), several times faster than the
+/// library's; the angles it gives only weight the vertex normal.
+double fast_acos(double x) {
+    x = std::clamp(x, -1.0, 1.0);
+    const double ax = std::fabs(x);
+    const double poly =
+        1.5707963050 +
+        ax * (-0.2145988016 +
+              ax * (0.0889789874 +
+                    ax * (-0.0501743046 +
+                          ax * (0.0308918810 +
+                                ax * (-0.0170881256 + ax * (0.0066700901 - ax * 0.0012624911))))));
+    const double r = std::sqrt(1.0 - ax) * poly;
+    return x >= 0 ? r : std::numbers::pi - r;
+}
+
+/// atan2 to within 2e-8 rad, and with a relative error below 2e-6 x^2 near 0, so that tiny
+/// dihedral angles keep their precision (Abramowitz and Stegun 4.4.49 after reduction to
+/// |t| <= 1).
+double fast_atan2(double y, double x) {
+    const double ay = std::fabs(y), ax = std::fabs(x);
+    if (ay == 0 && ax == 0) return 0;
+    const bool swap = ay > ax;
+    const double t = swap ? ax / ay : ay / ax;
+    const double t2 = t * t;
+    double r =
+        t *
+        (1.0 + t2 * (-0.3333314528 +
+                     t2 * (0.1999355085 +
+                           t2 * (-0.1420889944 +
+                                 t2 * (0.1065626393 +
+                                       t2 * (-0.0752896400 +
+                                             t2 * (0.0429096138 +
+                                                   t2 * (-0.0161657367 + t2 * 0.0028662257))))))));
+    if (swap) r = 0.5 * std::numbers::pi - r;
+    if (x < 0) r = std::numbers::pi - r;
+    return y < 0 ? -r : r;
 }
 
 VertexData first_pass(const Mesh& m, const FaceMap<Vec3>& face_normal, VertexId v) {
@@ -227,16 +251,26 @@ VertexData first_pass(const Mesh& m, const FaceMap<Vec3>& face_normal, VertexId 
     Vec3 normal{};
     double edge_sum = 0;
     int edges = 0;
+    HalfedgeId last{};
     for_each_outgoing(m, v, [&](HalfedgeId h) {
+        last = h;
         const FaceId f = Mesh::face(h);
-        const Vec3 p[3] = {pv, m.position(m.target(h)), m.position(m.origin(Mesh::prev(h)))};
-        const Vec3 u = p[1] - p[0], w = p[2] - p[0];
+        const Vec3 p1 = m.position(m.target(h)), p2 = m.position(m.origin(Mesh::prev(h)));
+        const Vec3 u = p1 - pv, w = p2 - pv;
         const double lu = norm(u), lw = norm(w);
-        if (lu > 0 && lw > 0) {
-            const double angle = std::acos(std::clamp(dot(u, w) / (lu * lw), -1.0, 1.0));
-            normal += angle * face_normal[f];
+        // Corner angle (normal weight) and mixed Voronoi share of this face (Meyer et al.).
+        const double d0 = dot(u, w), d1 = dot(pv - p1, p2 - p1), d2 = dot(pv - p2, p1 - p2);
+        const double area2 = norm(cross(u, w));
+        if (lu > 0 && lw > 0) normal += fast_acos(d0 / (lu * lw)) * face_normal[f];
+        if (area2 > 0) {
+            if (d0 < 0) {
+                out.area += 0.25 * area2;  // obtuse at v: half the face
+            } else if (d1 < 0 || d2 < 0) {
+                out.area += 0.125 * area2;  // obtuse elsewhere: a quarter
+            } else {
+                out.area += (lu * lu * d2 + lw * lw * d1) / (8.0 * area2);
+            }
         }
-        out.area += mixed_share(p, 0);
         edge_sum += lu;
         ++edges;
         if (lu > 0 && (out.min_edge == 0 || lu < out.min_edge)) out.min_edge = lu;
@@ -245,16 +279,13 @@ VertexData first_pass(const Mesh& m, const FaceMap<Vec3>& face_normal, VertexId 
         if (!t.is_valid() || lu <= 0) return;
         const Vec3 n1 = face_normal[f], n2 = face_normal[Mesh::face(t)];
         const Vec3 e = u / lu;
-        const double beta = std::atan2(dot(cross(n1, n2), e), std::clamp(dot(n1, n2), -1.0, 1.0));
+        const double beta = fast_atan2(dot(cross(n1, n2), e), dot(n1, n2));
         out.tensor.add_outer(e, beta * 0.5 * lu);
         out.max_turn = std::max(out.max_turn, std::fabs(beta));
     });
     // The last edge of an open fan has no outgoing half-edge from v: count its length too.
     const HalfedgeId h0 = m.outgoing(v);
     if (h0.is_valid() && !m.twin(h0).is_valid()) {
-        // h0 is the boundary one; the other boundary edge ends at v in the fan's last face.
-        HalfedgeId last = h0;
-        for_each_outgoing(m, v, [&](HalfedgeId g) { last = g; });
         const double l = norm(m.position(m.origin(Mesh::prev(last))) - pv);
         edge_sum += l;
         out.max_edge = std::max(out.max_edge, l);
@@ -409,6 +440,95 @@ Sym3 weighted_tensor(const Mesh& m, const FaceMap<Vec3>& face_normal, Vec3 np, c
     return sum;
 }
 
+/// The radius of p's kernel: kernel_edges shortest incident edges, at most kernel_angle times
+/// the curvature radius of p's own cell (|W| of the cell, its Frobenius norm).
+double reach(const VertexData& d, double kernel_edges, double kernel_angle) {
+    double r = kernel_edges * d.min_edge;
+    const double kf = d.area > 0 ? d.tensor.frobenius() / d.area : 0;
+    if (kf > 0) r = std::min(r, kernel_angle / kf);
+    return r;
+}
+
+/// The neighbours of every vertex as compressed rows (offsets, then ids in fan order): one
+/// linear scan per vertex instead of a walk over half-edges in every smoothing pass.
+struct Adjacency {
+    std::vector<std::uint32_t> offset, ids;
+};
+
+Adjacency adjacency(const Mesh& m) {
+    const std::size_t nv = m.num_vertices();
+    Adjacency a;
+    a.offset.assign(nv + 1, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
+        for (std::size_t v = r.begin(); v != r.end(); ++v) {
+            std::uint32_t n = 0;
+            for_each_neighbour(m, VertexId(static_cast<std::uint32_t>(v)), [&](VertexId) { ++n; });
+            a.offset[v + 1] = n;
+        }
+    });
+    for (std::size_t v = 0; v < nv; ++v) a.offset[v + 1] += a.offset[v];
+    a.ids.resize(a.offset[nv]);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
+        for (std::size_t v = r.begin(); v != r.end(); ++v) {
+            std::uint32_t* out = a.ids.data() + a.offset[v];
+            for_each_neighbour(m, VertexId(static_cast<std::uint32_t>(v)),
+                               [&](VertexId w) { *out++ = w.idx(); });
+        }
+    });
+    return a;
+}
+
+/// Neighbourhood::kSmoothed: `passes` rounds in which every vertex adds its eligible
+/// neighbours' tensors (transported to its tangent plane) and areas to its own. A neighbour is
+/// eligible when it is not on a sharp edge and it and its whole cell lie within p's reach.
+void smooth(const Mesh& m, const std::vector<VertexData>& data, const CurvatureOptions& o,
+            double sharp, double kernel_edges, double kernel_angle, std::vector<Sym3>& tensor,
+            std::vector<double>& area) {
+    const std::size_t nv = m.num_vertices();
+    const Adjacency adj = adjacency(m);
+    // Eligibility does not change between passes: mark it once per (vertex, neighbour) slot.
+    std::vector<std::uint8_t> eligible(adj.ids.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
+        for (std::size_t v = r.begin(); v != r.end(); ++v) {
+            tensor[v] = data[v].tensor;
+            area[v] = data[v].area;
+            const double radius = reach(data[v], kernel_edges, kernel_angle);
+            const Vec3 pv = m.position(VertexId(static_cast<std::uint32_t>(v)));
+            for (std::uint32_t k = adj.offset[v]; k < adj.offset[v + 1]; ++k) {
+                const VertexData& dq = data[adj.ids[k]];
+                const Vec3 d = m.position(VertexId(adj.ids[k])) - pv;
+                eligible[k] =
+                    dq.max_turn < sharp && dq.max_edge < radius && dot(d, d) < radius * radius;
+            }
+        }
+    });
+    std::vector<Sym3> next_tensor(nv);
+    std::vector<double> next_area(nv);
+    for (int pass = 0; pass < std::max(1, o.passes); ++pass) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
+            for (std::size_t v = r.begin(); v != r.end(); ++v) {
+                Sym3 t = tensor[v];
+                double a = area[v];
+                const Vec3 nv_ = data[v].normal;
+                for (std::uint32_t k = adj.offset[v]; k < adj.offset[v + 1]; ++k) {
+                    if (!eligible[k]) continue;
+                    const std::uint32_t q = adj.ids[k];
+                    a += area[q];
+                    if (o.transport) {
+                        t.add_rotated(tensor[q], data[q].normal, nv_);
+                    } else {
+                        t.add(tensor[q]);
+                    }
+                }
+                next_tensor[v] = t;
+                next_area[v] = a;
+            }
+        });
+        tensor.swap(next_tensor);
+        area.swap(next_area);
+    }
+}
+
 double median_edge_length(const Mesh& m) {
     const std::size_t nh = m.num_halfedges();
     const std::size_t stride = std::max<std::size_t>(1, nh / kMedianSample);
@@ -472,6 +592,12 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
         case Neighbourhood::kGeodesic:
             th.neighbourhood = "geodesic radius " + format_number(options.radius);
             break;
+        case Neighbourhood::kSmoothed:
+            th.neighbourhood = std::to_string(std::max(1, options.passes)) +
+                               " smoothing passes over neighbours within min(" +
+                               format_number(kernel_edges) + " x shortest incident edge, " +
+                               format_number(kernel_angle) + " / 1-ring curvature)";
+            break;
     }
 
     // Face normals, then everything a vertex knows of its own fan.
@@ -529,68 +655,91 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
 
     const double sharp = th.sharp_edge_angle;
     const double planar = th.planar_curvedness;
-    tbb::enumerable_thread_specific<Scratch> scratch;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
-        Scratch& s = scratch.local();
-        for (std::size_t vi = r.begin(); vi != r.end(); ++vi) {
-            const VertexId p(static_cast<std::uint32_t>(vi));
-            const VertexData& d = data[vi];
-            const Vec3 n = d.normal;
-            out.normal[p] = n;
-            double kernel_radius = 0;  // 0: every cell of the neighbourhood weighs 1
-            switch (options.neighbourhood) {
-                case Neighbourhood::kKernel: {
-                    const double kf = d.area > 0 ? d.tensor.frobenius() / d.area : 0;
-                    kernel_radius = kernel_edges * d.min_edge;
-                    if (kf > 0) kernel_radius = std::min(kernel_radius, kernel_angle / kf);
-                    ring_neighbourhood(m, data, sharp, p, kMaxRings, kernel_radius, true, s);
-                    break;
+    // The tensor and area of every vertex's neighbourhood.
+    std::vector<Sym3> tensor(nv);
+    std::vector<double> area(nv);
+    if (options.neighbourhood == Neighbourhood::kSmoothed) {
+        smooth(m, data, options, sharp, kernel_edges, kernel_angle, tensor, area);
+    } else {
+        tbb::enumerable_thread_specific<Scratch> scratch;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
+            Scratch& s = scratch.local();
+            for (std::size_t vi = r.begin(); vi != r.end(); ++vi) {
+                const VertexId p(static_cast<std::uint32_t>(vi));
+                const VertexData& d = data[vi];
+                double kernel_radius = 0;  // 0: every cell of the neighbourhood weighs 1
+                switch (options.neighbourhood) {
+                    case Neighbourhood::kKernel:
+                        kernel_radius = reach(d, kernel_edges, kernel_angle);
+                        ring_neighbourhood(m, data, sharp, p, kMaxRings, kernel_radius, true, s);
+                        break;
+                    case Neighbourhood::kRings:
+                        ring_neighbourhood(m, data, sharp, p, rings, kInfinity, false, s);
+                        break;
+                    case Neighbourhood::kGeodesic:
+                        geodesic_neighbourhood(m, data, sharp, p, options.radius, s);
+                        break;
+                    case Neighbourhood::kSmoothed:
+                        break;
                 }
-                case Neighbourhood::kRings:
-                    ring_neighbourhood(m, data, sharp, p, rings, kInfinity, false, s);
-                    break;
-                case Neighbourhood::kGeodesic:
-                    geodesic_neighbourhood(m, data, sharp, p, options.radius, s);
-                    break;
-            }
-            double area = 0;
-            Sym3 w;
-            if (options.estimator == CurvatureEstimator::kWeighted) {
-                for (const std::uint32_t q : s.set) area += data[q].area;
-                w = weighted_tensor(m, face_normal, n, s);
-            } else {
+                if (options.estimator == CurvatureEstimator::kWeighted) {
+                    for (const std::uint32_t q : s.set) area[vi] += data[q].area;
+                    tensor[vi] = weighted_tensor(m, face_normal, d.normal, s);
+                    continue;
+                }
                 const Vec3 pp = m.position(p);
+                Sym3 w = d.tensor;
+                double a = d.area;
                 for (const std::uint32_t q : s.set) {
-                    if (q == p.idx()) {
-                        area += d.area;
-                        w.add(d.tensor);
-                        continue;
-                    }
+                    if (q == p.idx()) continue;
                     double kw = 1.0;
                     if (kernel_radius > 0) {
                         const Vec3 dq = m.position(VertexId(q)) - pp;
                         const double t = dot(dq, dq) / (kernel_radius * kernel_radius);
                         kw = (1 - t) * (1 - t);
                     }
-                    area += kw * data[q].area;
+                    a += kw * data[q].area;
                     if (options.transport) {
-                        w.add_rotated(data[q].tensor, data[q].normal, n, kw);
+                        w.add_rotated(data[q].tensor, data[q].normal, d.normal, kw);
                     } else {
                         w.add(data[q].tensor, kw);
                     }
                 }
+                tensor[vi] = w;
+                area[vi] = a;
             }
+        });
+    }
+
+    // Principal curvatures and directions, shape index, curvedness, type, high.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
+        for (std::size_t vi = r.begin(); vi != r.end(); ++vi) {
+            const VertexId p(static_cast<std::uint32_t>(vi));
+            const VertexData& d = data[vi];
+            const Vec3 n = d.normal;
+            out.normal[p] = n;
+            const Sym3& w = tensor[vi];
             double k1 = 0, k2 = 0;
             Vec3 t1{}, t2{};
-            if (area > 0 && norm(n) > 0) {
+            if (area[vi] > 0 && norm(n) > 0) {
                 tangent_basis(n, t1, t2);
-                const double a = w.form(t1, t1) / area, b = w.form(t1, t2) / area,
-                             c = w.form(t2, t2) / area;
-                const double mean = 0.5 * (a + c);
-                const double radius = std::hypot(0.5 * (a - c), b);
+                const double inv = 1.0 / area[vi];
+                const double a = w.form(t1, t1) * inv, b = w.form(t1, t2) * inv,
+                             c = w.form(t2, t2) * inv;
+                const double mean = 0.5 * (a + c), half = 0.5 * (a - c);
+                const double radius = std::sqrt(half * half + b * b);
                 const double mu1 = mean + radius, mu2 = mean - radius;
-                const double theta = 0.5 * std::atan2(2.0 * b, a - c);
-                const Vec3 e1 = std::cos(theta) * t1 + std::sin(theta) * t2;  // of mu1
+                // Eigenvector of mu1: (b, mu1 - a) or (mu1 - c, b), whichever is longer.
+                double ex = b, ey = mu1 - a;
+                if (half > 0) ex = mu1 - c, ey = b;
+                const double el = std::sqrt(ex * ex + ey * ey);
+                if (el > 0) {
+                    ex /= el;
+                    ey /= el;
+                } else {
+                    ex = 1, ey = 0;  // umbilic: every direction is principal
+                }
+                const Vec3 e1 = ex * t1 + ey * t2;  // of mu1
                 // The eigenvector of an eigenvalue is the direction of the other curvature.
                 k1 = mu1;
                 k2 = mu2;
