@@ -82,10 +82,11 @@ enum class Neighbourhood {
     /// shorter than `radius`, all of weight 1.
     kGeodesic,
     /// `passes` rounds in which every vertex adds to its own tensor and area those of its
-    /// neighbours (each tensor transported to its tangent plane): after n rounds, the cells
-    /// within n rings weighted by the number of paths that reach them, a bell-shaped kernel
-    /// close to kKernel's at a fraction of its cost. A neighbour takes part only when it is
-    /// not on a sharp edge and it and its whole cell lie within the kernel radius of kKernel.
+    /// neighbours, each tensor carried to its tangent plane and weighted by the kernel of
+    /// kKernel: after n rounds, the cells within n rings under a bell-shaped kernel, about
+    /// kKernel's accuracy at a fraction of its cost (docs/curvature.md). A neighbour takes part
+    /// only when it is not on a sharp edge and it and its whole cell lie within p's kernel
+    /// radius. Always transported (`transport` is ignored).
     kSmoothed,
 };
 /// "kernel", "rings", "geodesic".
@@ -103,14 +104,14 @@ constexpr double kDefaultKernelAngle = 0.15;
 /// Options of compute_curvature(). The defaults need no tuning.
 struct CurvatureOptions {
     CurvatureEstimator estimator = CurvatureEstimator::kPlain;
-    Neighbourhood neighbourhood = Neighbourhood::kKernel;
+    Neighbourhood neighbourhood = Neighbourhood::kSmoothed;
     /// kRings: the number of rings, >= 1.
     int rings = 1;
     /// kGeodesic: the radius in model units, > 0.
     double radius = 0;
-    /// kSmoothed: the number of rounds, >= 1.
+    /// kSmoothed: the number of rounds, >= 1 (3: docs/curvature.md).
     int passes = 3;
-    /// kKernel: see Neighbourhood::kKernel; <= 0 selects the default.
+    /// kKernel and kSmoothed: see Neighbourhood::kKernel; <= 0 selects the default.
     double kernel_edges = kDefaultKernelEdges;
     double kernel_angle = kDefaultKernelAngle;
     /// Turn each neighbour's tensor by the rotation that takes its normal to p's before

@@ -15,15 +15,19 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <queue>
 #include <utility>
 #include <vector>
 
+#include "detail/huge_pages.h"
 #include "ncrev/io.h"
 
 namespace ncrev {
@@ -117,7 +121,7 @@ constexpr std::size_t kMaxNeighbourhood = 512;
 constexpr int kMaxRings = 64;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 /// At most this many edges are sampled (evenly) for the median edge length.
-constexpr std::size_t kMedianSample = 1 << 20;
+constexpr std::size_t kMedianSample = 1 << 16;
 
 /// Symmetric 3x3 tensor: xx, xy, xz, yy, yz, zz.
 struct Sym3 {
@@ -245,7 +249,79 @@ double fast_atan2(double y, double x) {
     return y < 0 ? -r : r;
 }
 
-VertexData first_pass(const Mesh& m, const FaceMap<Vec3>& face_normal, VertexId v) {
+/// What the face pass knows, indexed by face (normal) or by half-edge h = 3f + i, which is
+/// also the corner of face f at the origin of h.
+struct FaceData {
+    FaceMap<Vec3> normal;              ///< unit facet normals
+    std::vector<double> corner_angle;  ///< angle of the corner (vertex normal weight)
+    std::vector<double> corner_share;  ///< the corner's mixed Voronoi share of the face
+    std::vector<double> dihedral;      ///< signed dihedral angle at the edge of h; 0 on borders
+};
+
+FaceData face_pass(const Mesh& m) {
+    const std::size_t nf = m.num_faces();
+    FaceData fd;
+    detail::resize_huge(fd.normal.data(), nf);
+    detail::resize_huge(fd.corner_angle, 3 * nf);
+    detail::resize_huge(fd.corner_share, 3 * nf);
+    detail::resize_huge(fd.dihedral, 3 * nf);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf), [&](const auto& r) {
+        for (std::size_t f = r.begin(); f != r.end(); ++f) {
+            const FaceId ff(static_cast<std::uint32_t>(f));
+            const Vec3 p[3] = {m.position(m.vertex(ff, 0)), m.position(m.vertex(ff, 1)),
+                               m.position(m.vertex(ff, 2))};
+            const Vec3 c = cross(p[1] - p[0], p[2] - p[0]);
+            const double area2 = norm(c);
+            fd.normal[ff] = area2 > 0 ? c / area2 : Vec3{};
+            // Corner i: the dot of its two edges, their squared lengths.
+            double d[3], sq[3];  // sq[i]: squared length of the edge opposite corner i
+            for (int i = 0; i < 3; ++i) {
+                const Vec3 u = p[(i + 1) % 3] - p[i], w = p[(i + 2) % 3] - p[i];
+                d[i] = dot(u, w);
+                sq[(i + 2) % 3] = dot(u, u);  // edge i -> i+1 is opposite corner i+2
+            }
+            for (int i = 0; i < 3; ++i) {
+                const std::size_t h = 3 * f + static_cast<std::size_t>(i);
+                const int j = (i + 1) % 3, k = (i + 2) % 3;
+                const double lu2 = sq[k], lw2 = sq[j];  // edges i->j and i->k
+                const double denom = std::sqrt(lu2 * lw2);
+                fd.corner_angle[h] = denom > 0 ? fast_acos(d[i] / denom) : 0.0;
+                double share = 0;
+                if (area2 > 0) {
+                    if (d[i] < 0) {
+                        share = 0.25 * area2;  // obtuse here: half the face
+                    } else if (d[j] < 0 || d[k] < 0) {
+                        share = 0.125 * area2;  // obtuse elsewhere: a quarter
+                    } else {
+                        share = (lu2 * d[k] + lw2 * d[j]) / (8.0 * area2);
+                    }
+                }
+                fd.corner_share[h] = share;
+            }
+        }
+    });
+    // Dihedral angles once per edge, from the side with the smaller half-edge id.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, 3 * nf), [&](const auto& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const HalfedgeId h(static_cast<std::uint32_t>(i));
+            const HalfedgeId t = m.twin(h);
+            if (!t.is_valid()) {
+                fd.dihedral[i] = 0;
+                continue;
+            }
+            if (t.idx() < h.idx()) continue;
+            const Vec3 n1 = fd.normal[Mesh::face(h)], n2 = fd.normal[Mesh::face(t)];
+            const Vec3 e = m.position(m.target(h)) - m.position(m.origin(h));
+            const double len = norm(e);
+            const double beta = len > 0 ? fast_atan2(dot(cross(n1, n2), e) / len, dot(n1, n2)) : 0;
+            fd.dihedral[i] = beta;
+            fd.dihedral[t.idx()] = beta;
+        }
+    });
+    return fd;
+}
+
+VertexData vertex_pass(const Mesh& m, const FaceData& fd, VertexId v) {
     VertexData out;
     const Vec3 pv = m.position(v);
     Vec3 normal{};
@@ -254,33 +330,18 @@ VertexData first_pass(const Mesh& m, const FaceMap<Vec3>& face_normal, VertexId 
     HalfedgeId last{};
     for_each_outgoing(m, v, [&](HalfedgeId h) {
         last = h;
-        const FaceId f = Mesh::face(h);
-        const Vec3 p1 = m.position(m.target(h)), p2 = m.position(m.origin(Mesh::prev(h)));
-        const Vec3 u = p1 - pv, w = p2 - pv;
-        const double lu = norm(u), lw = norm(w);
-        // Corner angle (normal weight) and mixed Voronoi share of this face (Meyer et al.).
-        const double d0 = dot(u, w), d1 = dot(pv - p1, p2 - p1), d2 = dot(pv - p2, p1 - p2);
-        const double area2 = norm(cross(u, w));
-        if (lu > 0 && lw > 0) normal += fast_acos(d0 / (lu * lw)) * face_normal[f];
-        if (area2 > 0) {
-            if (d0 < 0) {
-                out.area += 0.25 * area2;  // obtuse at v: half the face
-            } else if (d1 < 0 || d2 < 0) {
-                out.area += 0.125 * area2;  // obtuse elsewhere: a quarter
-            } else {
-                out.area += (lu * lu * d2 + lw * lw * d1) / (8.0 * area2);
-            }
-        }
+        normal += fd.corner_angle[h.idx()] * fd.normal[Mesh::face(h)];
+        out.area += fd.corner_share[h.idx()];
+        const Vec3 u = m.position(m.target(h)) - pv;
+        const double lu = norm(u);
         edge_sum += lu;
         ++edges;
         if (lu > 0 && (out.min_edge == 0 || lu < out.min_edge)) out.min_edge = lu;
         out.max_edge = std::max(out.max_edge, lu);
-        const HalfedgeId t = m.twin(h);
-        if (!t.is_valid() || lu <= 0) return;
-        const Vec3 n1 = face_normal[f], n2 = face_normal[Mesh::face(t)];
-        const Vec3 e = u / lu;
-        const double beta = fast_atan2(dot(cross(n1, n2), e), dot(n1, n2));
-        out.tensor.add_outer(e, beta * 0.5 * lu);
+        const double beta = fd.dihedral[h.idx()];
+        if (beta == 0 || lu <= 0) return;
+        // beta |e|/2 e e^T with e = u / |u|.
+        out.tensor.add_outer(u, 0.5 * beta / lu);
         out.max_turn = std::max(out.max_turn, std::fabs(beta));
     });
     // The last edge of an open fan has no outgoing half-edge from v: count its length too.
@@ -478,55 +539,124 @@ Adjacency adjacency(const Mesh& m) {
     return a;
 }
 
+/// A tensor of a tangent plane in a vertex's frame (t1, t2): mean = (a + c) / 2,
+/// diff = (a - c) / 2, off = b for the matrix [[a, b], [b, c]]. Turning the frame by psi turns
+/// (diff, off) by 2 psi and leaves the mean alone.
+struct Planar {
+    double mean = 0, diff = 0, off = 0;
+};
+
 /// Neighbourhood::kSmoothed: `passes` rounds in which every vertex adds its eligible
-/// neighbours' tensors (transported to its tangent plane) and areas to its own. A neighbour is
-/// eligible when it is not on a sharp edge and it and its whole cell lie within p's reach.
+/// neighbours' tensors (carried to its own tangent plane) and areas to its own, weighted by
+/// the kernel (1 - d^2/R^2)^2 of their distance d, R being p's reach. A neighbour is eligible
+/// when it is not on a sharp edge and it and its whole cell lie within p's reach.
+///
+/// Why in 2D: the minimal rotation that takes a neighbour's normal to p's maps the neighbour's
+/// tangent frame onto p's turned by an angle psi, fixed per (p, neighbour) pair. Computing
+/// cos 2psi and sin 2psi once makes each round a few multiply-adds per neighbour instead of a
+/// 3x3 rotation.
 void smooth(const Mesh& m, const std::vector<VertexData>& data, const CurvatureOptions& o,
             double sharp, double kernel_edges, double kernel_angle, std::vector<Sym3>& tensor,
             std::vector<double>& area) {
     const std::size_t nv = m.num_vertices();
     const Adjacency adj = adjacency(m);
-    // Eligibility does not change between passes: mark it once per (vertex, neighbour) slot.
-    std::vector<std::uint8_t> eligible(adj.ids.size(), 0);
+    std::vector<Planar> cur, next;
+    detail::resize_huge(cur, nv);
+    detail::resize_huge(next, nv);
+    // Per (vertex, neighbour) slot: w cos 2psi, w sin 2psi and the kernel weight w, or NaN
+    // when not eligible.
+    std::vector<std::array<float, 3>> turn;
+    detail::resize_huge(turn, adj.ids.size());
+    // Compact per-vertex columns for the slot loop: normal, first frame axis, and how far the
+    // cell reaches (infinite on a sharp edge: never eligible).
+    std::vector<Vec3> normal, axis;
+    std::vector<double> extent;
+    detail::resize_huge(normal, nv);
+    detail::resize_huge(axis, nv);
+    detail::resize_huge(extent, nv);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
         for (std::size_t v = r.begin(); v != r.end(); ++v) {
-            tensor[v] = data[v].tensor;
-            area[v] = data[v].area;
+            const VertexData& dv = data[v];
+            Vec3 t1, t2;
+            tangent_basis(dv.normal, t1, t2);
+            normal[v] = dv.normal;
+            axis[v] = t1;
+            extent[v] = dv.max_turn < sharp ? dv.max_edge : kInfinity;
+            const double a = dv.tensor.form(t1, t1), b = dv.tensor.form(t1, t2),
+                         c = dv.tensor.form(t2, t2);
+            cur[v] = {0.5 * (a + c), 0.5 * (a - c), b};
+            area[v] = dv.area;
+        }
+    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
+        for (std::size_t v = r.begin(); v != r.end(); ++v) {
             const double radius = reach(data[v], kernel_edges, kernel_angle);
             const Vec3 pv = m.position(VertexId(static_cast<std::uint32_t>(v)));
+            const Vec3 np = normal[v], t1 = axis[v], t2 = cross(np, t1);
             for (std::uint32_t k = adj.offset[v]; k < adj.offset[v + 1]; ++k) {
-                const VertexData& dq = data[adj.ids[k]];
-                const Vec3 d = m.position(VertexId(adj.ids[k])) - pv;
-                eligible[k] =
-                    dq.max_turn < sharp && dq.max_edge < radius && dot(d, d) < radius * radius;
+                const std::uint32_t q = adj.ids[k];
+                const Vec3 d = m.position(VertexId(q)) - pv;
+                const Vec3 nq = normal[q];
+                const double cu = dot(nq, np);
+                if (!(extent[q] < radius && dot(d, d) < radius * radius && cu > -0.999)) {
+                    turn[k] = {std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f};
+                    continue;
+                }
+                // q's first axis carried by the minimal rotation n_q -> n_p, in p's frame.
+                const Vec3 q1 = axis[q];
+                const Vec3 u = cross(nq, np);
+                const Vec3 moved = cu * q1 + cross(u, q1) + (dot(u, q1) / (1.0 + cu)) * u;
+                const double x = dot(moved, t1), y = dot(moved, t2);
+                const double len2 = x * x + y * y;
+                const double inv = len2 > 0 ? 1.0 / len2 : 0.0;
+                const double t = dot(d, d) / (radius * radius);
+                const double weight = (1 - t) * (1 - t);
+                turn[k] = {static_cast<float>(weight * (len2 > 0 ? (x * x - y * y) * inv : 1.0)),
+                           static_cast<float>(weight * 2.0 * x * y * inv),
+                           static_cast<float>(weight)};
             }
         }
     });
-    std::vector<Sym3> next_tensor(nv);
-    std::vector<double> next_area(nv);
+    std::vector<double> next_area;
+    detail::resize_huge(next_area, nv);
     for (int pass = 0; pass < std::max(1, o.passes); ++pass) {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
             for (std::size_t v = r.begin(); v != r.end(); ++v) {
-                Sym3 t = tensor[v];
+                Planar t = cur[v];
                 double a = area[v];
-                const Vec3 nv_ = data[v].normal;
                 for (std::uint32_t k = adj.offset[v]; k < adj.offset[v + 1]; ++k) {
-                    if (!eligible[k]) continue;
+                    const float c2 = turn[k][0];
+                    if (std::isnan(c2)) continue;
+                    const float s2 = turn[k][1], w = turn[k][2];
                     const std::uint32_t q = adj.ids[k];
-                    a += area[q];
-                    if (o.transport) {
-                        t.add_rotated(tensor[q], data[q].normal, nv_);
-                    } else {
-                        t.add(tensor[q]);
-                    }
+                    const Planar& tq = cur[q];
+                    t.mean += w * tq.mean;
+                    t.diff += tq.diff * c2 - tq.off * s2;
+                    t.off += tq.diff * s2 + tq.off * c2;
+                    a += w * area[q];
                 }
-                next_tensor[v] = t;
+                next[v] = t;
                 next_area[v] = a;
             }
         });
-        tensor.swap(next_tensor);
+        cur.swap(next);
         area.swap(next_area);
     }
+    // Back to 3D in p's frame, for the common eigen-decomposition.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
+        for (std::size_t v = r.begin(); v != r.end(); ++v) {
+            Vec3 t1, t2;
+            tangent_basis(data[v].normal, t1, t2);
+            const Planar& t = cur[v];
+            Sym3 w;
+            w.add_outer(t1, t.mean + t.diff);
+            w.add_outer(t2, t.mean - t.diff);
+            // (t1 + t2)(t1 + t2)^T - (t1 - t2)(t1 - t2)^T = 2 (t1 t2^T + t2 t1^T).
+            w.add_outer(t1 + t2, 0.5 * t.off);
+            w.add_outer(t1 - t2, -0.5 * t.off);
+            tensor[v] = w;
+        }
+    });
 }
 
 double median_edge_length(const Mesh& m) {
@@ -544,22 +674,6 @@ double median_edge_length(const Mesh& m) {
     return *mid;
 }
 
-/// The rounding unit of the coordinates: float32's when every coordinate is a float (binary
-/// STL, or text written from floats), else double's.
-double coordinate_precision(const Mesh& m, double max_abs) {
-    bool all_float = true;
-    for (const Vec3& p : m.positions()) {
-        for (int i = 0; i < 3; ++i) {
-            if (static_cast<double>(static_cast<float>(p[i])) != p[i]) {
-                all_float = false;
-                break;
-            }
-        }
-        if (!all_float) break;
-    }
-    return max_abs * (all_float ? 0x1.0p-24 : 0x1.0p-53);
-}
-
 std::string format_number(double x) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.6g", x);
@@ -571,7 +685,7 @@ std::string format_number(double x) {
 CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options) {
     CurvatureResult result;
     CurvatureThresholds& th = result.thresholds;
-    const std::size_t nv = m.num_vertices(), nf = m.num_faces();
+    const std::size_t nv = m.num_vertices();
     const int rings = std::max(1, options.rings);
     const double kernel_edges =
         options.kernel_edges > 0 ? options.kernel_edges : kDefaultKernelEdges;
@@ -601,29 +715,47 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
     }
 
     // Face normals, then everything a vertex knows of its own fan.
-    FaceMap<Vec3> face_normal(nf);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf), [&](const auto& r) {
-        for (std::size_t f = r.begin(); f != r.end(); ++f) {
-            const FaceId ff(static_cast<std::uint32_t>(f));
-            face_normal[ff] = m.face_normal(ff);
-        }
-    });
-    std::vector<VertexData> data(nv);
+    const FaceData fd = face_pass(m);
+    const FaceMap<Vec3>& face_normal = fd.normal;
+    std::vector<VertexData> data;
+    detail::resize_huge(data, nv);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
         for (std::size_t v = r.begin(); v != r.end(); ++v)
-            data[v] = first_pass(m, face_normal, VertexId(static_cast<std::uint32_t>(v)));
+            data[v] = vertex_pass(m, fd, VertexId(static_cast<std::uint32_t>(v)));
     });
 
-    // Thresholds from the model's size and the mesh's resolution.
-    Box3 box;
-    double max_abs = 0;
-    for (const Vec3& p : m.positions()) {
-        box.add(p);
-        max_abs = std::max({max_abs, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    }
-    const double diagonal = box.empty() ? 0.0 : norm(box.max - box.min);
+    // Bounding box, largest |coordinate|, and whether every coordinate is a float32 (min, max
+    // and "and" are exact, so the parallel reduction is deterministic).
+    struct Extent {
+        Box3 box;
+        double max_abs = 0;
+        bool all_float = true;
+    };
+    const auto positions = m.positions();
+    const Extent ext = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, positions.size()), Extent{},
+        [&](const auto& r, Extent e) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const Vec3 p = positions[i];
+                e.box.add(p);
+                for (int k = 0; k < 3; ++k) {
+                    e.max_abs = std::max(e.max_abs, std::fabs(p[k]));
+                    e.all_float &= static_cast<double>(static_cast<float>(p[k])) == p[k];
+                }
+            }
+            return e;
+        },
+        [](Extent a, const Extent& b) {
+            a.box.add(b.box);
+            a.max_abs = std::max(a.max_abs, b.max_abs);
+            a.all_float = a.all_float && b.all_float;
+            return a;
+        });
+    const double diagonal = ext.box.empty() ? 0.0 : norm(ext.box.max - ext.box.min);
+    // The rounding unit of the coordinates: float32's when every coordinate is a float (binary
+    // STL, or text written from floats), else double's.
+    th.coordinate_precision = ext.max_abs * (ext.all_float ? 0x1.0p-24 : 0x1.0p-53);
     th.median_edge_length = median_edge_length(m);
-    th.coordinate_precision = coordinate_precision(m, max_abs);
     if (options.planar_curvedness >= 0) {
         th.planar_curvedness = options.planar_curvedness;
         th.planar_rule = "given";
@@ -643,21 +775,22 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
         "the sharp-edge angle / the mean length of the incident edges";
 
     CurvatureField& out = result.field;
-    out.k1 = VertexMap<double>(nv);
-    out.k2 = VertexMap<double>(nv);
-    out.dir1 = VertexMap<Vec3>(nv);
-    out.dir2 = VertexMap<Vec3>(nv);
-    out.normal = VertexMap<Vec3>(nv);
-    out.shape_index = VertexMap<double>(nv);
-    out.curvedness = VertexMap<double>(nv);
-    out.type = VertexMap<ShapeType>(nv, ShapeType::kPlane);
-    out.high = VertexMap<std::uint8_t>(nv, 0);
+    detail::resize_huge(out.k1.data(), nv);
+    detail::resize_huge(out.k2.data(), nv);
+    detail::resize_huge(out.dir1.data(), nv);
+    detail::resize_huge(out.dir2.data(), nv);
+    detail::resize_huge(out.normal.data(), nv);
+    detail::resize_huge(out.shape_index.data(), nv);
+    detail::resize_huge(out.curvedness.data(), nv);
+    detail::resize_huge(out.type.data(), nv);
+    detail::resize_huge(out.high.data(), nv);
 
     const double sharp = th.sharp_edge_angle;
     const double planar = th.planar_curvedness;
-    // The tensor and area of every vertex's neighbourhood.
-    std::vector<Sym3> tensor(nv);
-    std::vector<double> area(nv);
+    std::vector<Sym3> tensor;
+    std::vector<double> area;
+    detail::resize_huge(tensor, nv);
+    detail::resize_huge(area, nv);
     if (options.neighbourhood == Neighbourhood::kSmoothed) {
         smooth(m, data, options, sharp, kernel_edges, kernel_angle, tensor, area);
     } else {
@@ -711,7 +844,6 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
         });
     }
 
-    // Principal curvatures and directions, shape index, curvedness, type, high.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
         for (std::size_t vi = r.begin(); vi != r.end(); ++vi) {
             const VertexId p(static_cast<std::uint32_t>(vi));
