@@ -529,7 +529,8 @@ std::vector<std::pair<std::string, CurvatureOptions>> study_variants() {
         CurvatureOptions sm;
         sm.neighbourhood = Neighbourhood::kSmoothed;
         sm.passes = passes;
-        v.emplace_back("plain smoothed " + std::to_string(passes), sm);
+        v.emplace_back(
+            "plain smoothed " + std::to_string(passes) + (passes == 3 ? " (default)" : ""), sm);
     }
     return v;
 }
