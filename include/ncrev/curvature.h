@@ -96,7 +96,7 @@ const char* to_string(Neighbourhood neighbourhood);
 /// targets on irregular isotropic meshes; 2.5 does not).
 constexpr double kDefaultKernelEdges = 3.0;
 /// Default cap of the kernel radius as a fraction of the curvature radius (0.15: a kernel
-/// spans at most about 17 degrees of arc, so the curvature's own variation, e.g. along a cone,
+/// reaches at most about 9 degrees of arc, so the curvature's own variation, e.g. along a cone,
 /// does not bias the estimate; on coarse CAD meshes this leaves the 1-ring, which measures
 /// best there; docs/curvature.md).
 constexpr double kDefaultKernelAngle = 0.15;
