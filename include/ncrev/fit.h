@@ -1,0 +1,85 @@
+// fit: analytic surfaces fitted to points (../shared/docs/method.md, Step 4): plane, sphere,
+// cylinder, cone and torus, each from a robust start (a normal-based or algebraic solution)
+// refined by geometric least squares (Levenberg-Marquardt on the true point-to-surface
+// distances); the simplest kind within a tolerance; distance and closest point for each kind.
+//
+// Lengths are in the points' unit; angles in radians. Directions are unit vectors.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "ncrev/common.h"
+
+namespace ncrev {
+
+/// The kinds of analytic surface fit() knows, simplest first (the order kind selection tries).
+enum class FitKind : std::uint8_t { kPlane, kSphere, kCylinder, kCone, kTorus };
+constexpr int kNumFitKinds = 5;
+/// "plane", "sphere", "cylinder", "cone", "torus" (the SRE keywords).
+const char* to_string(FitKind kind);
+
+/// An analytic surface. Which fields mean something depends on `kind`:
+/// - plane: `point` on it, `axis` its unit normal;
+/// - sphere: `point` its center, `radius`;
+/// - cylinder: `point` on the axis, `axis` the unit axis direction, `radius`;
+/// - cone: `point` on the axis, `axis` the unit direction in which the radius grows, `radius`
+///   of the section through `point` (>= 0), `angle` the half-angle in (0, pi/2);
+/// - torus: `point` its center, `axis` its unit axis, `radius` the major radius R (center to
+///   tube center), `minor_radius` r.
+/// The orientation of `axis` carries no meaning except for cones.
+struct Surface {
+    FitKind kind = FitKind::kPlane;
+    Vec3 point;
+    Vec3 axis{0, 0, 1};
+    double radius = 0;
+    double angle = 0;
+    double minor_radius = 0;
+};
+
+/// Unsigned distance from `p` to the (unbounded) surface.
+double distance(const Surface& s, Vec3 p);
+/// The point of the surface nearest to `p` (for a point on a cylinder's or cone's axis, or at
+/// a sphere's or torus's center, one of the nearest points).
+Vec3 closest_point(const Surface& s, Vec3 p);
+
+/// Points to fit: positions, and optionally unit normals and weights (e.g. facet centroids,
+/// their normals and areas). Empty `normals` or `weights` spans mean none / all 1.
+struct FitInput {
+    std::span<const Vec3> points;
+    std::span<const Vec3> normals;
+    std::span<const double> weights;
+};
+
+/// The outcome of one fit: `ok` false when the points do not determine the surface (too few,
+/// collinear, a degenerate start, no convergence), with the reason in `failure`. Residuals are
+/// the distances of the points to the fitted surface: weighted RMS and maximum.
+struct FitResult {
+    bool ok = false;
+    Surface surface;
+    double rms = 0;
+    double max = 0;
+    int iterations = 0;
+    std::string failure;
+};
+
+/// Fits one kind. Cylinders, cones and tori need normals for their start (the axis is found
+/// as the line that meets every normal line); spheres and planes do not. Never throws.
+FitResult fit(FitKind kind, const FitInput& input);
+
+/// The simplest kind whose fit keeps every point within `tolerance` (max residual), in the
+/// order plane, sphere, cylinder, cone, torus, so that a plane is not called a cylinder of huge
+/// radius, nor a cylinder a cone of tiny angle; unless a kind with more parameters fits clearly
+/// better (RMS lower by more than 10 % plus 2 % of the tolerance): then the simpler one is
+/// biased, e.g. a cylinder fitted to a narrow strip of a cone. Every kind is fitted. `best.ok`
+/// false when none fits.
+struct KindSelection {
+    FitResult best;
+    std::array<FitResult, kNumFitKinds> tried;  ///< every fit attempted, by kind
+};
+KindSelection fit_simplest(const FitInput& input, double tolerance);
+
+}  // namespace ncrev

@@ -1,0 +1,669 @@
+// Surface fitting (../shared/docs/method.md, Step 4).
+//
+// Starts: the plane by weighted principal components; the sphere by the algebraic fit of
+// Kasa (|p|^2 + D.p + E = 0 in least squares); cylinders, cones and tori from their axis,
+// found as the line that meets every normal line (each normal of a surface of revolution meets
+// its axis), in Plücker coordinates (d, m): the line meets the normal line (p, n) when
+// d.(p x n) + n.m = 0, a linear condition, minimised over unit d with m eliminated (H. Pottmann
+// and J. Wallner, "Computational Line Geometry", 2001, ch. 6). The profile in the meridian
+// plane then gives the radius (cylinder), the generator line (cone) or the tube circle (torus).
+// Refinement: Levenberg-Marquardt on the geometric distances with analytic derivatives,
+// directions perturbed in their tangent plane and renormalised each step.
+#include "ncrev/fit.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace ncrev {
+
+const char* to_string(FitKind kind) {
+    switch (kind) {
+        case FitKind::kPlane:
+            return "plane";
+        case FitKind::kSphere:
+            return "sphere";
+        case FitKind::kCylinder:
+            return "cylinder";
+        case FitKind::kCone:
+            return "cone";
+        case FitKind::kTorus:
+            return "torus";
+    }
+    return "unknown";
+}
+
+namespace {
+
+/// Points per task of the parallel sums: fixed, so that the summation order, and so the bits
+/// of every result, do not depend on the thread count.
+constexpr std::size_t kGrain = 4096;
+/// Levenberg-Marquardt stops after this many iterations or when the cost decreases by less
+/// than kRelativeDecrease of itself (double precision leaves nothing to gain below).
+constexpr int kMaxIterations = 100;
+constexpr double kRelativeDecrease = 1e-14;
+/// Points whose second principal variance is below this fraction of the first lie on a line
+/// (to double precision): no surface is determined.
+constexpr double kCollinear = 1e-20;
+/// Kind selection: a simpler kind loses to a more complex one whose RMS residual is lower by
+/// more than this factor (noise alone lowers it by about 1/(2n) per parameter, n points)...
+constexpr double kSignificantRms = 1.1;
+/// ...plus this fraction of the tolerance, so that on exact data (every RMS at rounding level)
+/// the simplest kind wins.
+constexpr double kRmsFloor = 0.02;
+
+/// A unit vector orthogonal to unit d, and a third completing the frame.
+void frame(Vec3 d, Vec3& u, Vec3& v) {
+    const Vec3 a = std::fabs(d.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    u = normalized(cross(d, a));
+    v = cross(d, u);
+}
+
+double weight(const FitInput& in, std::size_t i) {
+    return in.weights.empty() ? 1.0 : in.weights[i];
+}
+
+bool finite(Vec3 p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
+
+/// Weighted centroid and total weight.
+Vec3 centroid(const FitInput& in, double* total = nullptr) {
+    Vec3 c{};
+    double w = 0;
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        c += weight(in, i) * in.points[i];
+        w += weight(in, i);
+    }
+    if (total) *total = w;
+    return w > 0 ? c / w : c;
+}
+
+/// A deterministic parallel sum over the points of f(i, acc).
+template <class Acc, class F>
+Acc sum_points(std::size_t n, F&& f) {
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, n, kGrain), Acc{},
+        [&](const tbb::blocked_range<std::size_t>& r, Acc acc) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) f(i, acc);
+            return acc;
+        },
+        [](Acc a, const Acc& b) {
+            a += b;
+            return a;
+        });
+}
+
+// ---------------------------------------------------------------------------------------
+// Models for Levenberg-Marquardt: residual(p, J) gives the signed distance of p and, when J
+// is not null, its derivatives by the N parameters; stepped(delta) the model moved by delta.
+
+struct SphereModel {
+    static constexpr int N = 4;
+    Vec3 c;
+    double r;
+    double residual(Vec3 p, double* J) const {
+        const Vec3 q = p - c;
+        const double len = norm(q);
+        if (J) {
+            const Vec3 e = len > 0 ? q / len : Vec3{1, 0, 0};
+            J[0] = -e.x, J[1] = -e.y, J[2] = -e.z, J[3] = -1;
+        }
+        return len - r;
+    }
+    SphereModel stepped(const double* d) const { return {c + Vec3{d[0], d[1], d[2]}, r + d[3]}; }
+    Surface surface() const {
+        Surface s;
+        s.kind = FitKind::kSphere;
+        s.point = c;
+        s.radius = r;
+        return s;
+    }
+};
+
+/// Axis through c along unit d; u, v complete the frame (parameters move c along u, v and tip
+/// d towards u, v).
+struct Axis {
+    Vec3 c, d, u, v;
+    static Axis make(Vec3 c, Vec3 d) {
+        Axis a{c, normalized(d), {}, {}};
+        frame(a.d, a.u, a.v);
+        return a;
+    }
+    Axis stepped(double cu, double cv, double du, double dv) const {
+        return make(c + cu * u + cv * v, d + du * u + dv * v);
+    }
+};
+
+struct CylinderModel {
+    static constexpr int N = 5;
+    Axis a;
+    double r;
+    double residual(Vec3 p, double* J) const {
+        const Vec3 q = p - a.c;
+        const double h = dot(q, a.d);
+        const Vec3 radial = q - h * a.d;
+        const double rho = norm(radial);
+        if (J) {
+            const Vec3 e = rho > 0 ? radial / rho : a.u;
+            const double eu = dot(e, a.u), ev = dot(e, a.v);
+            J[0] = -eu, J[1] = -ev, J[2] = -h * eu, J[3] = -h * ev, J[4] = -1;
+        }
+        return rho - r;
+    }
+    CylinderModel stepped(const double* d) const {
+        return {a.stepped(d[0], d[1], d[2], d[3]), r + d[4]};
+    }
+    Surface surface() const {
+        Surface s;
+        s.kind = FitKind::kCylinder;
+        s.point = a.c;
+        s.axis = a.d;
+        s.radius = r;
+        return s;
+    }
+};
+
+/// Cone: radius r at the axis point c, growing along d with half-angle alpha. The residual is
+/// the distance to the generator line in the meridian plane, rho cos(alpha) - r cos(alpha) -
+/// h sin(alpha), which is well conditioned also for small angles (no apex in the parameters).
+struct ConeModel {
+    static constexpr int N = 6;
+    Axis a;
+    double r, alpha;
+    double residual(Vec3 p, double* J) const {
+        const Vec3 q = p - a.c;
+        const double h = dot(q, a.d);
+        const Vec3 radial = q - h * a.d;
+        const double rho = norm(radial);
+        const double ca = std::cos(alpha), sa = std::sin(alpha);
+        if (J) {
+            const Vec3 e = rho > 0 ? radial / rho : a.u;
+            const double eu = dot(e, a.u), ev = dot(e, a.v);
+            J[0] = -ca * eu;
+            J[1] = -ca * ev;
+            J[2] = -ca * h * eu - sa * dot(q, a.u);
+            J[3] = -ca * h * ev - sa * dot(q, a.v);
+            J[4] = -ca;
+            J[5] = -rho * sa + r * sa - h * ca;
+        }
+        return (rho - r) * ca - h * sa;
+    }
+    ConeModel stepped(const double* d) const {
+        return {a.stepped(d[0], d[1], d[2], d[3]), r + d[4], alpha + d[5]};
+    }
+    Surface surface() const {
+        Surface s;
+        s.kind = FitKind::kCone;
+        s.point = a.c;
+        s.axis = a.d;
+        s.radius = r;
+        s.angle = alpha;
+        return s;
+    }
+};
+
+/// Torus: center c on the axis (moved along u, v and d), major R, minor r.
+struct TorusModel {
+    static constexpr int N = 7;
+    Axis a;
+    double R, r;
+    double residual(Vec3 p, double* J) const {
+        const Vec3 q = p - a.c;
+        const double h = dot(q, a.d);
+        const Vec3 radial = q - h * a.d;
+        const double rho = norm(radial);
+        const double dr = rho - R;
+        const double s = std::sqrt(dr * dr + h * h);
+        if (J) {
+            const Vec3 e = rho > 0 ? radial / rho : a.u;
+            const double eu = dot(e, a.u), ev = dot(e, a.v);
+            const double sr = s > 0 ? dr / s : 1.0, sh = s > 0 ? h / s : 0.0;
+            J[0] = -sr * eu;
+            J[1] = -sr * ev;
+            J[2] = -sr * h * eu + sh * dot(q, a.u);
+            J[3] = -sr * h * ev + sh * dot(q, a.v);
+            J[4] = -sh;  // the center moves along the axis
+            J[5] = -sr;
+            J[6] = -1;
+        }
+        return s - r;
+    }
+    TorusModel stepped(const double* d) const {
+        Axis moved = a.stepped(d[0], d[1], d[2], d[3]);
+        moved.c += d[4] * a.d;
+        return {moved, R + d[5], r + d[6]};
+    }
+    Surface surface() const {
+        Surface s;
+        s.kind = FitKind::kTorus;
+        s.point = a.c;
+        s.axis = a.d;
+        s.radius = R;
+        s.minor_radius = r;
+        return s;
+    }
+};
+
+template <int N>
+struct NormalEquations {
+    Eigen::Matrix<double, N, N> jtj = Eigen::Matrix<double, N, N>::Zero();
+    Eigen::Matrix<double, N, 1> jtr = Eigen::Matrix<double, N, 1>::Zero();
+    double cost = 0;
+    NormalEquations& operator+=(const NormalEquations& o) {
+        jtj += o.jtj;
+        jtr += o.jtr;
+        cost += o.cost;
+        return *this;
+    }
+};
+
+struct Cost {
+    double value = 0;
+    Cost& operator+=(const Cost& o) {
+        value += o.value;
+        return *this;
+    }
+};
+
+template <class Model>
+double cost_of(const Model& m, const FitInput& in) {
+    return sum_points<Cost>(in.points.size(),
+                            [&](std::size_t i, Cost& c) {
+                                const double r = m.residual(in.points[i], nullptr);
+                                c.value += weight(in, i) * r * r;
+                            })
+        .value;
+}
+
+/// Levenberg-Marquardt (Marquardt's scaling of the diagonal). Returns the iterations used, or
+/// -1 when the model became non-finite.
+template <class Model>
+int refine(Model& model, const FitInput& in) {
+    constexpr int N = Model::N;
+    double lambda = 1e-3;
+    int it = 0;
+    for (; it < kMaxIterations; ++it) {
+        const auto ne = sum_points<NormalEquations<N>>(
+            in.points.size(), [&](std::size_t i, NormalEquations<N>& acc) {
+                double J[N];
+                const double r = model.residual(in.points[i], J);
+                const double w = weight(in, i);
+                const Eigen::Map<const Eigen::Matrix<double, N, 1>> j(J);
+                acc.jtj.template selfadjointView<Eigen::Lower>().rankUpdate(j, w);
+                acc.jtr += (w * r) * j;
+                acc.cost += w * r * r;
+            });
+        const Eigen::Matrix<double, N, N> jtj = ne.jtj.template selfadjointView<Eigen::Lower>();
+        bool improved = false;
+        for (int tries = 0; tries < 12 && !improved; ++tries) {
+            Eigen::Matrix<double, N, N> a = jtj;
+            for (int k = 0; k < N; ++k) a(k, k) += lambda * std::max(jtj(k, k), 1e-300);
+            const Eigen::Matrix<double, N, 1> delta = a.ldlt().solve(-ne.jtr);
+            if (!delta.allFinite()) {
+                lambda *= 10;
+                continue;
+            }
+            const Model next = model.stepped(delta.data());
+            const double c = cost_of(next, in);
+            if (std::isfinite(c) && c <= ne.cost) {
+                const double decrease = ne.cost - c;
+                model = next;
+                lambda = std::max(lambda / 3, 1e-12);
+                improved = true;
+                if (decrease <= kRelativeDecrease * ne.cost) return it + 1;
+            } else {
+                lambda *= 4;
+            }
+        }
+        if (!improved) return it + 1;  // at a minimum to machine precision
+    }
+    return it;
+}
+
+template <class Model>
+FitResult finish(const Model& model, int iterations, const FitInput& in) {
+    FitResult res;
+    res.surface = model.surface();
+    res.iterations = iterations;
+    struct Stats {
+        double sum = 0, weight = 0, max = 0;
+        Stats& operator+=(const Stats& o) {
+            sum += o.sum;
+            weight += o.weight;
+            max = std::max(max, o.max);
+            return *this;
+        }
+    };
+    const Stats st = sum_points<Stats>(in.points.size(), [&](std::size_t i, Stats& s) {
+        const double d = distance(res.surface, in.points[i]);
+        const double w = weight(in, i);
+        s.sum += w * d * d;
+        s.weight += w;
+        s.max = std::max(s.max, d);
+    });
+    res.rms = st.weight > 0 ? std::sqrt(st.sum / st.weight) : 0;
+    res.max = st.max;
+    const Surface& s = res.surface;
+    res.ok = iterations >= 0 && finite(s.point) && finite(s.axis) && std::isfinite(s.radius) &&
+             std::isfinite(s.angle) && std::isfinite(s.minor_radius) && std::isfinite(res.rms);
+    if (!res.ok) res.failure = "the refinement diverged";
+    return res;
+}
+
+FitResult failed(FitKind kind, std::string why) {
+    FitResult r;
+    r.surface.kind = kind;
+    r.failure = std::move(why);
+    return r;
+}
+
+FitResult fit_plane(const FitInput& in) {
+    double total = 0;
+    const Vec3 c = centroid(in, &total);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        const Vec3 q = in.points[i] - c;
+        const Eigen::Vector3d e(q.x, q.y, q.z);
+        cov += weight(in, i) * e * e.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+    if (es.info() != Eigen::Success || !(es.eigenvalues()(1) > 0)) {
+        return failed(FitKind::kPlane, "the points are collinear or coincide");
+    }
+    const Eigen::Vector3d n = es.eigenvectors().col(0);
+    Surface s;
+    s.kind = FitKind::kPlane;
+    s.point = c;
+    s.axis = normalized(Vec3{n(0), n(1), n(2)});
+    // Orient the normal with the given normals, when there are any.
+    if (!in.normals.empty()) {
+        double agree = 0;
+        for (std::size_t i = 0; i < in.normals.size(); ++i)
+            agree += weight(in, i) * dot(in.normals[i], s.axis);
+        if (agree < 0) s.axis = -s.axis;
+    }
+    struct Wrap {
+        Surface s;
+        Surface surface() const { return s; }
+    };
+    return finish(Wrap{s}, 0, in);
+}
+
+FitResult fit_sphere(const FitInput& in) {
+    const Vec3 c0 = centroid(in);
+    // Kasa: |q|^2 + D.q + E = 0 for q = p - c0, linear in (D, E).
+    Eigen::Matrix4d ata = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d atb = Eigen::Vector4d::Zero();
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        const Vec3 q = in.points[i] - c0;
+        const Eigen::Vector4d row(q.x, q.y, q.z, 1.0);
+        const double w = weight(in, i);
+        ata += w * row * row.transpose();
+        atb -= w * dot(q, q) * row;
+    }
+    const Eigen::Vector4d x = ata.ldlt().solve(atb);
+    const Vec3 center{-0.5 * x(0), -0.5 * x(1), -0.5 * x(2)};
+    const double r2 = dot(center, center) - x(3);
+    if (!x.allFinite() || !(r2 > 0))
+        return failed(FitKind::kSphere, "no sphere through the points");
+    SphereModel m{c0 + center, std::sqrt(r2)};
+    const int it = refine(m, in);
+    if (m.r < 0) m.r = -m.r;
+    return finish(m, it, in);
+}
+
+/// The line that best meets every normal line (see the top of the file): unit direction and
+/// the point of the line nearest to `origin`. False when the normals leave it undetermined.
+bool axis_from_normals(const FitInput& in, Vec3 origin, Vec3& point, Vec3& dir) {
+    if (in.normals.size() != in.points.size()) return false;
+    // Rows (p x n, n) with p relative to origin: minimise over unit d and free m.
+    Eigen::Matrix<double, 6, 6> M = Eigen::Matrix<double, 6, 6>::Zero();
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        const Vec3 p = in.points[i] - origin, n = in.normals[i];
+        const Vec3 pn = cross(p, n);
+        Eigen::Matrix<double, 6, 1> row;
+        row << pn.x, pn.y, pn.z, n.x, n.y, n.z;
+        M += weight(in, i) * row * row.transpose();
+    }
+    const Eigen::Matrix3d A = M.topLeftCorner<3, 3>(), B = M.topRightCorner<3, 3>(),
+                          C = M.bottomRightCorner<3, 3>();
+    // m = -C^+ B^T d (C is singular for a cylinder: the normals span a plane only).
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> ec(C);
+    if (ec.info() != Eigen::Success) return false;
+    const double cmax = ec.eigenvalues().maxCoeff();
+    if (!(cmax > 0)) return false;
+    Eigen::Matrix3d cinv = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+        const double l = ec.eigenvalues()(k);
+        if (l > 1e-9 * cmax)
+            cinv += (1.0 / l) * ec.eigenvectors().col(k) * ec.eigenvectors().col(k).transpose();
+    }
+    const Eigen::Matrix3d schur = A - B * cinv * B.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(schur);
+    if (es.info() != Eigen::Success) return false;
+    const Eigen::Vector3d d = es.eigenvectors().col(0);
+    // Undetermined when a second direction fits about as well (a sphere, a plane).
+    const Eigen::Vector3d ev = es.eigenvalues();
+    if (!(ev(1) > 1e-6 * std::max(ev(2), 1e-300))) return false;
+    const Eigen::Vector3d m = -cinv * B.transpose() * d;
+    dir = normalized(Vec3{d(0), d(1), d(2)});
+    const Vec3 mm{m(0), m(1), m(2)};
+    point = origin + cross(dir, mm);
+    return finite(point) && finite(dir) && norm(dir) > 0;
+}
+
+/// Meridian coordinates of p about an axis: h along d from c, rho from the axis.
+void meridian(Vec3 p, Vec3 c, Vec3 d, double& h, double& rho) {
+    const Vec3 q = p - c;
+    h = dot(q, d);
+    rho = norm(q - h * d);
+}
+
+FitResult fit_cylinder(const FitInput& in) {
+    Vec3 c, d;
+    if (!axis_from_normals(in, centroid(in), c, d)) {
+        return failed(FitKind::kCylinder, "the normals do not determine an axis");
+    }
+    double sum = 0, total = 0;
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        double h, rho;
+        meridian(in.points[i], c, d, h, rho);
+        sum += weight(in, i) * rho;
+        total += weight(in, i);
+    }
+    // Put the axis point level with the centroid: parameters stay well conditioned.
+    const Vec3 g = centroid(in);
+    c += dot(g - c, d) * d;
+    CylinderModel m{Axis::make(c, d), sum / total};
+    const int it = refine(m, in);
+    return finish(m, it, in);
+}
+
+FitResult fit_cone(const FitInput& in) {
+    Vec3 c, d;
+    if (!axis_from_normals(in, centroid(in), c, d)) {
+        return failed(FitKind::kCone, "the normals do not determine an axis");
+    }
+    const Vec3 g = centroid(in);
+    c += dot(g - c, d) * d;
+    // The generator line rho = r + t h, by weighted least squares in the meridian plane.
+    double sw = 0, sh = 0, sr = 0, shh = 0, shr = 0;
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        double h, rho;
+        meridian(in.points[i], c, d, h, rho);
+        const double w = weight(in, i);
+        sw += w, sh += w * h, sr += w * rho, shh += w * h * h, shr += w * h * rho;
+    }
+    const double den = sw * shh - sh * sh;
+    if (!(den > 0)) return failed(FitKind::kCone, "the points span no height along the axis");
+    double t = (sw * shr - sh * sr) / den;
+    const double r = (sr - t * sh) / sw;
+    if (t < 0) {
+        d = -d;  // the radius grows along the axis direction
+        t = -t;
+    }
+    ConeModel m{Axis::make(c, d), r, std::atan(t)};
+    const int it = refine(m, in);
+    if (m.alpha < 0) {  // crossed through a cylinder: turn the axis round
+        m.a = Axis::make(m.a.c, -m.a.d);
+        m.alpha = -m.alpha;
+    }
+    FitResult res = finish(m, it, in);
+    if (res.ok && !(m.alpha > 0 && m.alpha < 0.5 * std::numbers::pi)) {
+        res.ok = false;
+        res.failure = "the half-angle left (0, pi/2)";
+    }
+    if (res.ok && m.r < 0) {
+        res.ok = false;
+        res.failure = "the points lie across the apex";
+    }
+    return res;
+}
+
+FitResult fit_torus(const FitInput& in) {
+    Vec3 c, d;
+    if (!axis_from_normals(in, centroid(in), c, d)) {
+        return failed(FitKind::kTorus, "the normals do not determine an axis");
+    }
+    // The tube circle in the meridian plane: Kasa fit of (rho, h).
+    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        double h, rho;
+        meridian(in.points[i], c, d, h, rho);
+        const Eigen::Vector3d row(rho, h, 1.0);
+        const double w = weight(in, i);
+        ata += w * row * row.transpose();
+        atb -= w * (rho * rho + h * h) * row;
+    }
+    const Eigen::Vector3d x = ata.ldlt().solve(atb);
+    const double R = -0.5 * x(0), h0 = -0.5 * x(1);
+    const double r2 = R * R + h0 * h0 - x(2);
+    if (!x.allFinite() || !(r2 > 0))
+        return failed(FitKind::kTorus, "no tube circle through the profile");
+    TorusModel m{Axis::make(c + h0 * d, d), R, std::sqrt(r2)};
+    const int it = refine(m, in);
+    FitResult res = finish(m, it, in);
+    if (res.ok && !(m.r > 0 && m.R > 0)) {
+        res.ok = false;
+        res.failure = "the radii left their range";
+    }
+    return res;
+}
+
+}  // namespace
+
+double distance(const Surface& s, Vec3 p) { return norm(p - closest_point(s, p)); }
+
+Vec3 closest_point(const Surface& s, Vec3 p) {
+    const Vec3 q = p - s.point;
+    switch (s.kind) {
+        case FitKind::kPlane:
+            return p - dot(q, s.axis) * s.axis;
+        case FitKind::kSphere: {
+            const double len = norm(q);
+            const Vec3 e = len > 0 ? q / len : Vec3{1, 0, 0};
+            return s.point + s.radius * e;
+        }
+        case FitKind::kCylinder:
+        case FitKind::kCone:
+        case FitKind::kTorus: {
+            const double h = dot(q, s.axis);
+            const Vec3 radial = q - h * s.axis;
+            const double rho = norm(radial);
+            Vec3 e;
+            if (rho > 0) {
+                e = radial / rho;
+            } else {
+                Vec3 v;
+                frame(s.axis, e, v);
+            }
+            if (s.kind == FitKind::kCylinder) return s.point + h * s.axis + s.radius * e;
+            if (s.kind == FitKind::kTorus) {
+                const Vec3 tube = s.point + s.radius * e;
+                const Vec3 w = p - tube;
+                const double lw = norm(w);
+                return tube + s.minor_radius * (lw > 0 ? w / lw : s.axis);
+            }
+            // Cone: the nearest point of the half-line from the apex along the generator.
+            const double ta = std::tan(s.angle);
+            const double ha = ta > 0 ? -s.radius / ta : -std::numeric_limits<double>::infinity();
+            const double ca = std::cos(s.angle), sa = std::sin(s.angle);
+            const double t = (h - ha) * ca + rho * sa;
+            const Vec3 apex = s.point + ha * s.axis;
+            if (t <= 0) return apex;
+            return apex + t * (ca * s.axis + sa * e);
+        }
+    }
+    return p;
+}
+
+FitResult fit(FitKind kind, const FitInput& in) {
+    const std::size_t n = in.points.size();
+    if (!in.weights.empty() && in.weights.size() != n) {
+        return failed(kind, "weights and points differ in number");
+    }
+    if (!in.normals.empty() && in.normals.size() != n) {
+        return failed(kind, "normals and points differ in number");
+    }
+    constexpr std::size_t kMinPoints[kNumFitKinds] = {3, 4, 5, 6, 7};
+    if (n < kMinPoints[static_cast<int>(kind)]) return failed(kind, "too few points");
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!finite(in.points[i]) || (!in.weights.empty() && !(in.weights[i] >= 0))) {
+            return failed(kind, "a point or weight is not a finite number");
+        }
+    }
+    // Every kind needs points that span a plane at least.
+    {
+        const Vec3 c = centroid(in);
+        Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+        for (std::size_t i = 0; i < n; ++i) {
+            const Vec3 q = in.points[i] - c;
+            const Eigen::Vector3d e(q.x, q.y, q.z);
+            cov += weight(in, i) * e * e.transpose();
+        }
+        const Eigen::Vector3d ev =
+            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues();
+        if (!(ev(1) > kCollinear * ev(2)))
+            return failed(kind, "the points are collinear or coincide");
+    }
+    switch (kind) {
+        case FitKind::kPlane:
+            return fit_plane(in);
+        case FitKind::kSphere:
+            return fit_sphere(in);
+        case FitKind::kCylinder:
+            return fit_cylinder(in);
+        case FitKind::kCone:
+            return fit_cone(in);
+        case FitKind::kTorus:
+            return fit_torus(in);
+    }
+    return failed(kind, "unknown kind");
+}
+
+KindSelection fit_simplest(const FitInput& input, double tolerance) {
+    KindSelection sel;
+    double best_rms = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < kNumFitKinds; ++k) {
+        sel.tried[static_cast<std::size_t>(k)] = fit(static_cast<FitKind>(k), input);
+        const FitResult& r = sel.tried[static_cast<std::size_t>(k)];
+        if (r.ok) best_rms = std::min(best_rms, r.rms);
+    }
+    for (const FitResult& r : sel.tried) {
+        if (!r.ok || r.max > tolerance) continue;
+        // A kind with more parameters that fits clearly better reveals a biased simpler one
+        // (a narrow strip of a cone fits a cylinder within a loose tolerance, but worse).
+        if (r.rms > kSignificantRms * best_rms + kRmsFloor * tolerance) continue;
+        sel.best = r;
+        return sel;
+    }
+    sel.best.failure = "no kind fits within the tolerance";
+    return sel;
+}
+
+}  // namespace ncrev

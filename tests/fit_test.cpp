@@ -1,0 +1,358 @@
+// Surface fitting against known parameters (issue 6): whole and partial patches of every kind
+// (down to a 30 degree arc of a cylinder, a 90 degree band of a torus, a small cap of a
+// sphere), exact and with noise, float32-rounded, placed by random rigid motions; kind
+// selection; distances and closest points; meshed surfaces.
+#include "ncrev/fit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "analytic_shapes.h"
+#include "ncrev/curvature.h"
+#include "ncrev/mesh.h"
+
+namespace ncrev {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180;
+
+struct Patch {
+    std::string name;
+    Surface truth;
+    std::vector<Vec3> points, normals;
+    double size = 0;  ///< bounding-box diagonal of the points
+};
+
+/// A random rotation (axis and angle from the rng) applied to v.
+Vec3 rotate(Vec3 v, Vec3 axis, double angle) {
+    const Vec3 k = normalized(axis);
+    return std::cos(angle) * v + std::sin(angle) * cross(k, v) +
+           (1 - std::cos(angle)) * dot(k, v) * k;
+}
+
+/// Builds a patch in a local frame (axis z, center at the origin), then moves it rigidly.
+/// `sample(u, v)` gives a local point and its outward normal for u, v in [0, 1].
+template <class F>
+Patch make_patch(const std::string& name, Surface local, std::size_t n, test::Rng& rng,
+                 F&& sample) {
+    Patch p;
+    p.name = name;
+    const Vec3 axis{rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5};
+    const double angle = 2 * kPi * rng.uniform();
+    const Vec3 shift{200 * rng.uniform() - 100, 200 * rng.uniform() - 100,
+                     200 * rng.uniform() - 100};
+    Box3 box;
+    for (std::size_t i = 0; i < n; ++i) {
+        Vec3 q, nq;
+        sample(rng.uniform(), rng.uniform(), q, nq);
+        p.points.push_back(rotate(q, axis, angle) + shift);
+        p.normals.push_back(rotate(nq, axis, angle));
+        box.add(p.points.back());
+    }
+    p.size = norm(box.max - box.min);
+    local.point = rotate(local.point, axis, angle) + shift;
+    local.axis = rotate(local.axis, axis, angle);
+    p.truth = local;
+    return p;
+}
+
+Patch plane_patch(test::Rng& rng, std::size_t n = 1000) {
+    Surface s;
+    s.kind = FitKind::kPlane;
+    return make_patch("plane", s, n, rng, [](double u, double v, Vec3& q, Vec3& nq) {
+        q = {40 * u - 20, 30 * v - 15, 0};
+        nq = {0, 0, 1};
+    });
+}
+
+Patch sphere_patch(test::Rng& rng, double r, double cap_deg, std::size_t n = 1000) {
+    Surface s;
+    s.kind = FitKind::kSphere;
+    s.radius = r;
+    const double cmax = std::cos(cap_deg * kDeg);
+    return make_patch("sphere cap " + std::to_string(int(cap_deg)) + " deg", s, n, rng,
+                      [=](double u, double v, Vec3& q, Vec3& nq) {
+                          const double z = 1 - u * (1 - cmax), phi = 2 * kPi * v;
+                          const double sr = std::sqrt(std::max(0.0, 1 - z * z));
+                          nq = {sr * std::cos(phi), sr * std::sin(phi), z};
+                          q = r * nq;
+                      });
+}
+
+Patch cylinder_patch(test::Rng& rng, double r, double arc_deg, double height,
+                     std::size_t n = 1000) {
+    Surface s;
+    s.kind = FitKind::kCylinder;
+    s.radius = r;
+    return make_patch("cylinder arc " + std::to_string(int(arc_deg)) + " deg", s, n, rng,
+                      [=](double u, double v, Vec3& q, Vec3& nq) {
+                          const double phi = arc_deg * kDeg * u;
+                          nq = {std::cos(phi), std::sin(phi), 0};
+                          q = Vec3{r * nq.x, r * nq.y, height * (v - 0.5)};
+                      });
+}
+
+/// Radius r at z = 0, growing along +z with half-angle alpha, for z in [-h/2, h/2].
+Patch cone_patch(test::Rng& rng, double r, double alpha_deg, double arc_deg, double height,
+                 std::size_t n = 1000) {
+    Surface s;
+    s.kind = FitKind::kCone;
+    s.radius = r;
+    s.angle = alpha_deg * kDeg;
+    const double ta = std::tan(s.angle), ca = std::cos(s.angle), sa = std::sin(s.angle);
+    return make_patch("cone arc " + std::to_string(int(arc_deg)) + " deg", s, n, rng,
+                      [=](double u, double v, Vec3& q, Vec3& nq) {
+                          const double phi = arc_deg * kDeg * u, z = height * (v - 0.5);
+                          const double rho = r + z * ta;
+                          q = {rho * std::cos(phi), rho * std::sin(phi), z};
+                          nq = {ca * std::cos(phi), ca * std::sin(phi), -sa};
+                      });
+}
+
+Patch torus_patch(test::Rng& rng, double R, double r, double u_deg, double v_deg,
+                  std::size_t n = 1000) {
+    Surface s;
+    s.kind = FitKind::kTorus;
+    s.radius = R;
+    s.minor_radius = r;
+    return make_patch("torus band " + std::to_string(int(u_deg)) + "x" + std::to_string(int(v_deg)),
+                      s, n, rng, [=](double u, double v, Vec3& q, Vec3& nq) {
+                          const double a = u_deg * kDeg * u, b = v_deg * kDeg * (v - 0.5);
+                          nq = {std::cos(b) * std::cos(a), std::cos(b) * std::sin(a), std::sin(b)};
+                          q = Vec3{R * std::cos(a), R * std::sin(a), 0} + r * nq;
+                      });
+}
+
+void add_noise(Patch& p, double sigma, test::Rng& rng) {
+    for (Vec3& q : p.points)
+        q += Vec3{sigma * rng.gaussian(), sigma * rng.gaussian(), sigma * rng.gaussian()};
+}
+
+double axis_angle_deg(Vec3 a, Vec3 b, bool oriented) {
+    const double c = dot(normalized(a), normalized(b));
+    return std::acos(std::clamp(oriented ? c : std::fabs(c), -1.0, 1.0)) / kDeg;
+}
+
+/// Distance from point q to the line through p along d.
+double line_distance(Vec3 q, Vec3 p, Vec3 d) {
+    const Vec3 w = q - p;
+    return norm(w - dot(w, normalized(d)) * normalized(d));
+}
+
+struct ParamErrors {
+    double radius = 0, minor = 0, angle = 0, axis_deg = 0, position = 0;  // relative / degrees
+};
+
+ParamErrors compare(const Surface& fit, const Patch& p) {
+    const Surface& t = p.truth;
+    ParamErrors e;
+    switch (t.kind) {
+        case FitKind::kPlane:
+            e.axis_deg = axis_angle_deg(fit.axis, t.axis, false);
+            e.position = std::fabs(dot(fit.point - t.point, t.axis)) / p.size;
+            break;
+        case FitKind::kSphere:
+            e.radius = std::fabs(fit.radius - t.radius) / t.radius;
+            e.position = norm(fit.point - t.point) / p.size;
+            break;
+        case FitKind::kCylinder:
+            e.radius = std::fabs(fit.radius - t.radius) / t.radius;
+            e.axis_deg = axis_angle_deg(fit.axis, t.axis, false);
+            e.position = line_distance(fit.point, t.point, t.axis) / p.size;
+            break;
+        case FitKind::kCone: {
+            e.axis_deg = axis_angle_deg(fit.axis, t.axis, true);
+            e.position = line_distance(fit.point, t.point, t.axis) / p.size;
+            e.angle = std::fabs(fit.angle - t.angle) / t.angle;
+            // The true radius at the fitted reference point.
+            const double h = dot(fit.point - t.point, t.axis);
+            const double r_true = t.radius + h * std::tan(t.angle);
+            e.radius = std::fabs(fit.radius - r_true) / r_true;
+            break;
+        }
+        case FitKind::kTorus:
+            e.radius = std::fabs(fit.radius - t.radius) / t.radius;
+            e.minor = std::fabs(fit.minor_radius - t.minor_radius) / t.minor_radius;
+            e.axis_deg = axis_angle_deg(fit.axis, t.axis, false);
+            e.position = norm(fit.point - t.point) / p.size;
+            break;
+    }
+    return e;
+}
+
+FitResult fit_patch(const Patch& p) { return fit(p.truth.kind, FitInput{p.points, p.normals, {}}); }
+
+/// The patches of the targets, `n` points each.
+std::vector<Patch> target_patches(test::Rng& rng, std::size_t n = 1000) {
+    return {plane_patch(rng, n),
+            sphere_patch(rng, 25, 20, n),
+            sphere_patch(rng, 8, 90, n),
+            cylinder_patch(rng, 12, 30, 20, n),
+            cylinder_patch(rng, 5, 360, 30, n),
+            cone_patch(rng, 10, 30, 30, 10, n),
+            cone_patch(rng, 10, 5, 120, 20, n),
+            torus_patch(rng, 30, 6, 90, 90, n),
+            torus_patch(rng, 20, 5, 30, 180, n),
+            torus_patch(rng, 10, 4, 360, 360, n)};
+}
+
+TEST(Fit, ExactPatchesGiveTheirParameters) {
+    test::Rng rng(11);
+    for (const Patch& p : target_patches(rng)) {
+        const FitResult r = fit_patch(p);
+        ASSERT_TRUE(r.ok) << p.name << ": " << r.failure;
+        EXPECT_EQ(r.surface.kind, p.truth.kind);
+        const ParamErrors e = compare(r.surface, p);
+        EXPECT_LE(e.radius, 0.0005) << p.name;
+        EXPECT_LE(e.minor, 0.0005) << p.name;
+        EXPECT_LE(e.angle, 0.0005) << p.name;
+        EXPECT_LE(e.axis_deg, 0.01) << p.name;
+        EXPECT_LE(e.position, 1e-4) << p.name;
+        EXPECT_LE(r.max, 1e-6 * p.size) << p.name;
+    }
+}
+
+TEST(Fit, NoisyPatchesStayWithinHalfAPercent) {
+    // 20000 points: on a 30 degree arc the radius error from the noise falls as 1/sqrt(n)
+    // (DISABLED_Probe: worst of 20 arcs 1.3 % with 1000 points, 0.66 % with 4000, 0.48 %
+    // with 16000).
+    test::Rng rng(12);
+    for (int round = 0; round < 5; ++round) {
+        for (Patch p : target_patches(rng, 20000)) {
+            add_noise(p, 0.001 * p.size, rng);
+            const FitResult r = fit_patch(p);
+            ASSERT_TRUE(r.ok) << p.name << ": " << r.failure;
+            const ParamErrors e = compare(r.surface, p);
+            EXPECT_LE(e.radius, 0.005) << p.name;
+            EXPECT_LE(e.minor, 0.005) << p.name;
+            // Only the noise across the surface counts: sigma per coordinate.
+            EXPECT_NEAR(r.rms, 0.001 * p.size, 0.0002 * p.size) << p.name;
+        }
+    }
+}
+
+TEST(Fit, DISABLED_Probe) {
+    for (std::size_t n : {1000u, 4000u, 16000u, 64000u}) {
+        double worst = 0, mean = 0;
+        for (int seed = 0; seed < 20; ++seed) {
+            test::Rng rng(100 + seed);
+            Patch p = cylinder_patch(rng, 12, 30, 20, n);
+            add_noise(p, 0.001 * p.size, rng);
+            const FitResult r = fit_patch(p);
+            const double e = compare(r.surface, p).radius;
+            worst = std::max(worst, e);
+            mean += e / 20;
+        }
+        std::printf("n %zu: mean %.5f worst %.5f\n", n, mean, worst);
+    }
+}
+
+TEST(Fit, SimplestKindIsChosenWithNoise) {
+    test::Rng rng(13);
+    int right = 0, total = 0;
+    for (int round = 0; round < 10; ++round) {
+        for (Patch p : target_patches(rng)) {
+            const double sigma = 0.001 * p.size;
+            add_noise(p, sigma, rng);
+            // The tolerance a mesh's chordal error would give: a few sigma of the noise.
+            const KindSelection s = fit_simplest(FitInput{p.points, p.normals, {}}, 5 * sigma);
+            ++total;
+            right += s.best.ok && s.best.surface.kind == p.truth.kind;
+            EXPECT_EQ(s.best.surface.kind, p.truth.kind) << p.name << " round " << round;
+        }
+    }
+    EXPECT_GE(right, 0.99 * total);
+}
+
+TEST(Fit, FloatRoundingKeepsTheTargets) {
+    test::Rng rng(14);
+    for (Patch p : target_patches(rng)) {
+        for (Vec3& q : p.points)
+            for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(q[k]);
+        const FitResult r = fit_patch(p);
+        ASSERT_TRUE(r.ok) << p.name;
+        const ParamErrors e = compare(r.surface, p);
+        EXPECT_LE(e.radius, 0.0005) << p.name;
+        EXPECT_LE(e.axis_deg, 0.01) << p.name;
+        EXPECT_LE(e.position, 1e-4) << p.name;
+    }
+}
+
+TEST(Fit, DistanceAndClosestPointAgree) {
+    test::Rng rng(15);
+    for (const Patch& p : target_patches(rng)) {
+        const Surface& s = p.truth;
+        for (std::size_t i = 0; i < 50; ++i) {
+            // On the surface: distance 0, closest point itself.
+            EXPECT_LE(distance(s, p.points[i]), 1e-9 * p.size) << p.name;
+            // Moved along the normal by a small step: distance = the step, closest = back.
+            const double step = 0.01 * p.size * (i % 2 ? 1 : -1);
+            const Vec3 off = p.points[i] + step * p.normals[i];
+            EXPECT_NEAR(distance(s, off), std::fabs(step), 1e-9 * p.size) << p.name;
+            EXPECT_LE(norm(closest_point(s, off) - p.points[i]), 1e-8 * p.size) << p.name;
+        }
+    }
+}
+
+TEST(Fit, DegenerateInputFailsCleanly) {
+    const std::vector<Vec3> line = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0},
+                                    {4, 0, 0}, {5, 0, 0}, {6, 0, 0}, {7, 0, 0}};
+    const std::vector<Vec3> up(line.size(), Vec3{0, 0, 1});
+    for (int k = 0; k < kNumFitKinds; ++k) {
+        const FitResult r = fit(static_cast<FitKind>(k), FitInput{line, up, {}});
+        EXPECT_FALSE(r.ok) << to_string(static_cast<FitKind>(k));
+        EXPECT_FALSE(r.failure.empty());
+    }
+    EXPECT_FALSE(fit(FitKind::kSphere, FitInput{std::span(line).first(2), {}, {}}).ok)
+        << "2 points";
+    const std::vector<Vec3> nan = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {NAN, 0, 0}};
+    EXPECT_FALSE(fit(FitKind::kPlane, FitInput{nan, {}, {}}).ok) << "NaN";
+    // A plane needs no normals; a cylinder does.
+    test::Rng rng(16);
+    const Patch c = cylinder_patch(rng, 10, 90, 10);
+    EXPECT_FALSE(fit(FitKind::kCylinder, FitInput{c.points, {}, {}}).ok) << "no normals";
+    const std::vector<double> bad_weights(c.points.size() - 1, 1.0);
+    EXPECT_FALSE(fit(FitKind::kPlane, FitInput{c.points, {}, bad_weights}).ok) << "weights";
+}
+
+TEST(Fit, MeshedSurfacesFromVerticesAndVertexNormals) {
+    // Isotropic and CAD-like meshes: the vertices lie on the surface; the vertex normals are
+    // estimates (used only for the start).
+    test::IsoOptions o;
+    o.facets = 20000;
+    o.jitter = 0.3;
+    test::IsoOptions cad = o;
+    cad.aspect = 6;
+    struct Case {
+        test::AnalyticMesh mesh;
+        Surface truth;
+    };
+    Surface cyl;
+    cyl.kind = FitKind::kCylinder, cyl.radius = 10, cyl.axis = {0, 0, 1};
+    Surface tor;
+    tor.kind = FitKind::kTorus, tor.radius = 30, tor.minor_radius = 10, tor.axis = {0, 0, 1};
+    Surface sph;
+    sph.kind = FitKind::kSphere, sph.radius = 10;
+    const std::vector<Case> cases = {{test::iso_cylinder(10, 30, o), cyl},
+                                     {test::iso_cylinder(10, 30, cad), cyl},
+                                     {test::iso_torus(30, 10, o), tor},
+                                     {test::iso_sphere(10, o), sph}};
+    for (const Case& c : cases) {
+        const Mesh mesh = build_mesh(test::to_indexed_soup(c.mesh.mesh)).value().mesh;
+        const VertexMap<Vec3> normals = vertex_normals(mesh);
+        const std::vector<Vec3> pts(mesh.positions().begin(), mesh.positions().end());
+        const KindSelection s = fit_simplest(FitInput{pts, normals.data(), {}}, 1e-6);
+        ASSERT_TRUE(s.best.ok) << c.mesh.name;
+        EXPECT_EQ(s.best.surface.kind, c.truth.kind) << c.mesh.name;
+        EXPECT_NEAR(s.best.surface.radius, c.truth.radius, 1e-6 * c.truth.radius) << c.mesh.name;
+        EXPECT_NEAR(s.best.surface.minor_radius, c.truth.minor_radius, 1e-6 * 10) << c.mesh.name;
+    }
+}
+
+}  // namespace
+}  // namespace ncrev
