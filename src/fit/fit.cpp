@@ -47,6 +47,10 @@ constexpr std::size_t kGrain = 4096;
 /// than kRelativeDecrease of itself (double precision leaves nothing to gain below).
 constexpr int kMaxIterations = 100;
 constexpr double kRelativeDecrease = 1e-14;
+/// A radius beyond this multiple of the points' extent has run away (a torus fitted to a
+/// cylinder's points, a sphere to a plane's): stop refining and report no fit.
+constexpr double kRunaway = 1000.0;
+constexpr double kTorusRunaway = 100.0;
 /// Points whose second principal variance is below this fraction of the first lie on a line
 /// (to double precision): no surface is determined.
 constexpr double kCollinear = 1e-20;
@@ -115,6 +119,7 @@ struct SphereModel {
         return len - r;
     }
     SphereModel stepped(const double* d) const { return {c + Vec3{d[0], d[1], d[2]}, r + d[3]}; }
+    bool runaway(double extent) const { return std::fabs(r) > kRunaway * extent; }
     Surface surface() const {
         Surface s;
         s.kind = FitKind::kSphere;
@@ -157,6 +162,7 @@ struct CylinderModel {
     CylinderModel stepped(const double* d) const {
         return {a.stepped(d[0], d[1], d[2], d[3]), r + d[4]};
     }
+    bool runaway(double extent) const { return std::fabs(r) > kRunaway * extent; }
     Surface surface() const {
         Surface s;
         s.kind = FitKind::kCylinder;
@@ -195,6 +201,7 @@ struct ConeModel {
     ConeModel stepped(const double* d) const {
         return {a.stepped(d[0], d[1], d[2], d[3]), r + d[4], alpha + d[5]};
     }
+    bool runaway(double extent) const { return std::fabs(r) > kRunaway * extent; }
     Surface surface() const {
         Surface s;
         s.kind = FitKind::kCone;
@@ -236,6 +243,11 @@ struct TorusModel {
         Axis moved = a.stepped(d[0], d[1], d[2], d[3]);
         moved.c += d[4] * a.d;
         return {moved, R + d[5], r + d[6]};
+    }
+    // A torus degenerates into a cylinder or a plane through ever larger radii; a machined
+    // torus (a fillet, a bull-nose corner) is never 100 times larger than the patch it covers.
+    bool runaway(double extent) const {
+        return std::fabs(R) > kTorusRunaway * extent || std::fabs(r) > kTorusRunaway * extent;
     }
     Surface surface() const {
         Surface s;
@@ -280,10 +292,13 @@ double cost_of(const Model& m, const FitInput& in) {
 }
 
 /// Levenberg-Marquardt (Marquardt's scaling of the diagonal). Returns the iterations used, or
-/// -1 when the model became non-finite.
+/// -2 when a radius ran away (the points are better described by a simpler kind).
 template <class Model>
 int refine(Model& model, const FitInput& in) {
     constexpr int N = Model::N;
+    Box3 box;
+    for (const Vec3& p : in.points) box.add(p);
+    const double extent = norm(box.max - box.min);
     double lambda = 1e-3;
     int it = 0;
     for (; it < kMaxIterations; ++it) {
@@ -314,6 +329,7 @@ int refine(Model& model, const FitInput& in) {
                 model = next;
                 lambda = std::max(lambda / 3, 1e-12);
                 improved = true;
+                if (model.runaway(extent)) return -2;
                 if (decrease <= kRelativeDecrease * ne.cost) return it + 1;
             } else {
                 lambda *= 4;
@@ -350,7 +366,10 @@ FitResult finish(const Model& model, int iterations, const FitInput& in) {
     const Surface& s = res.surface;
     res.ok = iterations >= 0 && finite(s.point) && finite(s.axis) && std::isfinite(s.radius) &&
              std::isfinite(s.angle) && std::isfinite(s.minor_radius) && std::isfinite(res.rms);
-    if (!res.ok) res.failure = "the refinement diverged";
+    if (!res.ok) {
+        res.failure = iterations == -2 ? "a radius ran away: the points are nearly a simpler kind"
+                                       : "the refinement diverged";
+    }
     return res;
 }
 
