@@ -354,5 +354,70 @@ TEST(Fit, MeshedSurfacesFromVerticesAndVertexNormals) {
     }
 }
 
+TEST(FitSnap, NearlyRoundValuesBecomeRoundAndTrueOnesStay) {
+    // A cylinder of radius 10.02 along z, 0.05 degrees off, with 0.001 mm noise.
+    test::Rng rng(21);
+    std::vector<Vec3> pts, nrm;
+    const double tilt = 0.05 * kDeg;
+    for (int i = 0; i < 5000; ++i) {
+        const double a = 2.0 * kPi / 3 * rng.uniform(), z = 40 * rng.uniform();
+        const Vec3 n{std::cos(a), std::sin(a), 0};
+        Vec3 q = Vec3{10.02 * n.x, 10.02 * n.y, z};
+        q = rotate(q, {1, 0, 0}, tilt) + Vec3{5, 7, -3};
+        q += Vec3{0.001 * rng.gaussian(), 0.001 * rng.gaussian(), 0.001 * rng.gaussian()};
+        pts.push_back(q);
+        nrm.push_back(rotate(n, {1, 0, 0}, tilt));
+    }
+    const FitInput in{pts, nrm, {}};
+    const FitResult f = fit(FitKind::kCylinder, in);
+    ASSERT_TRUE(f.ok);
+    SnapOptions o;
+    o.tolerance = 0.1;
+    std::vector<std::string> applied;
+    const FitResult s = snap(f, in, o, &applied);
+    ASSERT_TRUE(s.ok);
+    EXPECT_EQ(s.surface.radius, 10.0);
+    EXPECT_EQ(std::fabs(s.surface.axis.z), 1.0);
+    EXPECT_LE(s.max, 0.1);
+    ASSERT_EQ(applied.size(), 2u);
+    EXPECT_EQ(applied[0].substr(0, 7), "axis to");
+    // With a tight tolerance the 0.035 mm of tilt and 0.02 mm of radius are real: the axis
+    // stays, and the radius only rounds to its true 10.02.
+    o.tolerance = 0.006;
+    applied.clear();
+    const FitResult tight = snap(f, in, o, &applied);
+    EXPECT_EQ(tight.surface.radius, 10.02);
+    EXPECT_LT(std::fabs(tight.surface.axis.z), 1.0);
+    ASSERT_EQ(applied.size(), 1u);
+    EXPECT_EQ(applied[0], "radius 10.0201 -> 10.02");
+    // A tool radius close by wins over round values.
+    o.tolerance = 0.1;
+    o.tool_radii = {6.35, 10.025};
+    applied.clear();
+    const FitResult tool = snap(f, in, o, &applied);
+    EXPECT_EQ(tool.surface.radius, 10.025);
+}
+
+TEST(FitSnap, ConeAnglesAndTorusRadii) {
+    test::Rng rng(22);
+    Patch cone = cone_patch(rng, 10, 29.999, 180, 10, 4000);
+    const FitResult fc = fit_patch(cone);
+    ASSERT_TRUE(fc.ok);
+    SnapOptions o;
+    o.tolerance = 1e-3;
+    o.axes = false;
+    std::vector<std::string> applied;
+    const FitResult sc = snap(fc, FitInput{cone.points, cone.normals, {}}, o, &applied);
+    EXPECT_NEAR(sc.surface.angle, 30 * kDeg, 1e-12);
+    EXPECT_EQ(applied.size(), 1u);
+    Patch tor = torus_patch(rng, 20.0004, 3.0002, 90, 180, 4000);
+    const FitResult ft = fit_patch(tor);
+    applied.clear();
+    const FitResult st = snap(ft, FitInput{tor.points, tor.normals, {}}, o, &applied);
+    EXPECT_EQ(st.surface.radius, 20.0);
+    EXPECT_EQ(st.surface.minor_radius, 3.0);
+    EXPECT_EQ(applied.size(), 2u);
+}
+
 }  // namespace
 }  // namespace ncrev

@@ -82,4 +82,24 @@ struct KindSelection {
 };
 KindSelection fit_simplest(const FitInput& input, double tolerance);
 
+/// What snap() may do. Every change is kept only when the refitted surface (the snapped values
+/// held, the other parameters fitted again) still keeps every point within `tolerance`.
+struct SnapOptions {
+    double tolerance = 0;  ///< max residual allowed after snapping, model units
+    /// Axes and plane normals to the nearest coordinate axis when within 2 degrees.
+    bool axes = true;
+    /// Radii to round values (multiples of 1, 0.5, 0.1, 0.05, 0.01 model units, coarsest
+    /// first) and cone half-angles to multiples of 5, 1, 0.5 degrees.
+    bool round_values = true;
+    /// Radii to try before round values, e.g. the radii of the tools of an SRE file
+    /// (diameter / 2, corner radius): the nearest one that keeps the tolerance wins.
+    std::vector<double> tool_radii;
+};
+
+/// A fit with machined-part values: see SnapOptions. `applied` lists what was snapped, in
+/// words (e.g. "axis to +z", "radius 9.9987 -> 10"). Returns `fit` unchanged when it is not ok
+/// or nothing snaps.
+FitResult snap(const FitResult& fit, const FitInput& input, const SnapOptions& options,
+               std::vector<std::string>* applied = nullptr);
+
 }  // namespace ncrev

@@ -17,8 +17,11 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
+#include <string>
+#include <vector>
 
 namespace ncrev {
 
@@ -40,6 +43,7 @@ const char* to_string(FitKind kind) {
 
 namespace {
 
+constexpr double kPi = std::numbers::pi;
 /// Points per task of the parallel sums: fixed, so that the summation order, and so the bits
 /// of every result, do not depend on the thread count.
 constexpr std::size_t kGrain = 4096;
@@ -294,7 +298,7 @@ double cost_of(const Model& m, const FitInput& in) {
 /// Levenberg-Marquardt (Marquardt's scaling of the diagonal). Returns the iterations used, or
 /// -2 when a radius ran away (the points are better described by a simpler kind).
 template <class Model>
-int refine(Model& model, const FitInput& in) {
+int refine(Model& model, const FitInput& in, unsigned frozen = 0) {
     constexpr int N = Model::N;
     Box3 box;
     for (const Vec3& p : in.points) box.add(p);
@@ -306,6 +310,8 @@ int refine(Model& model, const FitInput& in) {
             in.points.size(), [&](std::size_t i, NormalEquations<N>& acc) {
                 double J[N];
                 const double r = model.residual(in.points[i], J);
+                for (int k = 0; k < N; ++k)
+                    if (frozen & (1u << k)) J[k] = 0;  // held parameters do not move
                 const double w = weight(in, i);
                 const Eigen::Map<const Eigen::Matrix<double, N, 1>> j(J);
                 acc.jtj.template selfadjointView<Eigen::Lower>().rankUpdate(j, w);
@@ -317,6 +323,8 @@ int refine(Model& model, const FitInput& in) {
         for (int tries = 0; tries < 12 && !improved; ++tries) {
             Eigen::Matrix<double, N, N> a = jtj;
             for (int k = 0; k < N; ++k) a(k, k) += lambda * std::max(jtj(k, k), 1e-300);
+            for (int k = 0; k < N; ++k)
+                if (frozen & (1u << k)) a(k, k) = 1;  // and get a zero step
             const Eigen::Matrix<double, N, 1> delta = a.ldlt().solve(-ne.jtr);
             if (!delta.allFinite()) {
                 lambda *= 10;
@@ -683,6 +691,143 @@ KindSelection fit_simplest(const FitInput& input, double tolerance) {
     }
     sel.best.failure = "no kind fits within the tolerance";
     return sel;
+}
+
+namespace {
+
+/// Parameter bits of the models (see their residual()).
+constexpr unsigned kDirBits = (1u << 2) | (1u << 3);
+constexpr double kAxisSnapDegrees = 2.0;
+constexpr double kRadiusSteps[] = {1.0, 0.5, 0.1, 0.05, 0.01};
+constexpr double kAngleStepsDegrees[] = {5.0, 1.0, 0.5};
+
+template <class Model>
+FitResult refit(Model m, unsigned frozen, const FitInput& in) {
+    const int it = refine(m, in, frozen);
+    return finish(m, it, in);
+}
+
+/// Refits `s` with the parameters in `frozen` held at their values in `s`.
+FitResult refit_surface(const Surface& s, unsigned frozen, const FitInput& in) {
+    switch (s.kind) {
+        case FitKind::kPlane: {
+            // A held normal: the best plane passes through the weighted centroid.
+            struct Wrap {
+                Surface s;
+                Surface surface() const { return s; }
+            };
+            Surface p = s;
+            p.point = centroid(in);
+            return finish(Wrap{p}, 0, in);
+        }
+        case FitKind::kSphere:
+            return refit(SphereModel{s.point, s.radius}, frozen, in);
+        case FitKind::kCylinder:
+            return refit(CylinderModel{Axis::make(s.point, s.axis), s.radius}, frozen, in);
+        case FitKind::kCone:
+            return refit(ConeModel{Axis::make(s.point, s.axis), s.radius, s.angle}, frozen, in);
+        case FitKind::kTorus:
+            return refit(TorusModel{Axis::make(s.point, s.axis), s.radius, s.minor_radius}, frozen,
+                         in);
+    }
+    return {};
+}
+
+std::string number(double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", x);
+    return buf;
+}
+
+}  // namespace
+
+FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
+               std::vector<std::string>* applied) {
+    if (!fit0.ok) return fit0;
+    FitResult cur = fit0;
+    unsigned frozen = 0;
+    auto accept = [&](const FitResult& r) { return r.ok && r.max <= o.tolerance; };
+    auto note = [&](const std::string& what) {
+        if (applied) applied->push_back(what);
+    };
+    const FitKind kind = cur.surface.kind;
+    // 1. The axis (or a plane's normal) to a coordinate axis.
+    if (o.axes && kind != FitKind::kSphere) {
+        static const char* kNames[3] = {"x", "y", "z"};
+        for (int k = 0; k < 3; ++k) {
+            Vec3 e{};
+            e[k] = 1;
+            const double c = dot(cur.surface.axis, e);
+            if (std::fabs(c) < std::cos(kAxisSnapDegrees * kPi / 180)) continue;
+            Surface s = cur.surface;
+            s.axis = c > 0 ? e : -e;
+            const FitResult r = refit_surface(s, frozen | kDirBits, in);
+            if (accept(r)) {
+                cur = r;
+                frozen |= kDirBits;
+                note(std::string("axis to ") + (c > 0 ? "+" : "-") + kNames[k]);
+            }
+            break;
+        }
+    }
+    // 2. Radii: tool radii first, then round values. Bit of each radius in its model.
+    struct RadiusSlot {
+        double Surface::*field;
+        unsigned bit;
+        const char* name;
+    };
+    std::vector<RadiusSlot> slots;
+    if (kind == FitKind::kSphere) slots.push_back({&Surface::radius, 1u << 3, "radius"});
+    if (kind == FitKind::kCylinder) slots.push_back({&Surface::radius, 1u << 4, "radius"});
+    if (kind == FitKind::kTorus) {
+        slots.push_back({&Surface::minor_radius, 1u << 6, "minor radius"});
+        slots.push_back({&Surface::radius, 1u << 5, "major radius"});
+    }
+    for (const RadiusSlot& slot : slots) {
+        const double value = cur.surface.*(slot.field);
+        std::vector<double> candidates;
+        std::vector<double> tools = o.tool_radii;
+        std::sort(tools.begin(), tools.end(),
+                  [&](double a, double b) { return std::fabs(a - value) < std::fabs(b - value); });
+        for (double t : tools)
+            if (t > 0) candidates.push_back(t);
+        if (o.round_values) {
+            for (double step : kRadiusSteps) {
+                const double rounded = std::round(value / step) * step;
+                if (rounded > 0) candidates.push_back(rounded);
+            }
+        }
+        for (double cand : candidates) {
+            if (cand == value) break;  // already round
+            Surface s = cur.surface;
+            s.*(slot.field) = cand;
+            const FitResult r = refit_surface(s, frozen | slot.bit, in);
+            if (accept(r)) {
+                note(std::string(slot.name) + " " + number(value) + " -> " + number(cand));
+                cur = r;
+                frozen |= slot.bit;
+                break;
+            }
+        }
+    }
+    // 3. A cone's half-angle to round degrees.
+    if (kind == FitKind::kCone && o.round_values) {
+        const double deg = cur.surface.angle * 180 / kPi;
+        for (double step : kAngleStepsDegrees) {
+            const double rounded = std::round(deg / step) * step;
+            if (rounded <= 0 || rounded >= 90) continue;
+            if (rounded == deg) break;
+            Surface s = cur.surface;
+            s.angle = rounded * kPi / 180;
+            const FitResult r = refit_surface(s, frozen | (1u << 5), in);
+            if (accept(r)) {
+                note("half-angle " + number(deg) + " -> " + number(rounded) + " deg");
+                cur = r;
+                break;
+            }
+        }
+    }
+    return cur;
 }
 
 }  // namespace ncrev
