@@ -181,6 +181,8 @@ ParamErrors compare(const Surface& fit, const Patch& p) {
             e.axis_deg = axis_angle_deg(fit.axis, t.axis, false);
             e.position = norm(fit.point - t.point) / p.size;
             break;
+        case FitKind::kBSpline:
+            break;
     }
     return e;
 }
@@ -352,6 +354,56 @@ TEST(Fit, MeshedSurfacesFromVerticesAndVertexNormals) {
         EXPECT_NEAR(s.best.surface.radius, c.truth.radius, 1e-6 * c.truth.radius) << c.mesh.name;
         EXPECT_NEAR(s.best.surface.minor_radius, c.truth.minor_radius, 1e-6 * 10) << c.mesh.name;
     }
+}
+
+/// A free-form height field (a die's bumps) over 40 x 30, moved rigidly.
+Patch freeform_patch(test::Rng& rng, std::size_t n) {
+    Surface s;
+    s.kind = FitKind::kBSpline;
+    return make_patch("free-form", s, n, rng, [](double u, double v, Vec3& q, Vec3& nq) {
+        const double x = 40 * u, y = 30 * v;
+        q = {x, y, 3 * std::sin(x / 8) * std::cos(y / 11) + 0.02 * x * y};
+        nq = normalized(Vec3{-(3.0 / 8 * std::cos(x / 8) * std::cos(y / 11) + 0.02 * y),
+                             -(-3.0 / 11 * std::sin(x / 8) * std::sin(y / 11) + 0.02 * x), 1});
+    });
+}
+
+TEST(FitBSpline, FreeFormPatchWithinToleranceAndChosenLast) {
+    test::Rng rng(31);
+    const Patch p = freeform_patch(rng, 5000);
+    const double tol = 1e-3 * p.size;
+    const FitInput in{p.points, p.normals, {}};
+    const FitResult r = fit_bspline(in, tol);
+    ASSERT_TRUE(r.ok) << r.failure;
+    ASSERT_TRUE(r.surface.bspline);
+    EXPECT_LE(r.max, tol);
+    const BSplineSurface& b = *r.surface.bspline;
+    EXPECT_LE(b.num_u * b.num_v, 32 * 32) << b.num_u << " x " << b.num_v;  // a sensible net
+    EXPECT_EQ(b.poles.size(), static_cast<std::size_t>(b.num_u * b.num_v));
+    // No analytic kind fits; the B-spline does.
+    const KindSelection s = fit_simplest(in, tol);
+    ASSERT_TRUE(s.best.ok);
+    EXPECT_EQ(s.best.surface.kind, FitKind::kBSpline);
+    // Distance and closest point: points moved off along their normals come back.
+    for (std::size_t i = 0; i < 100; ++i) {
+        const double step = 0.01 * p.size;
+        const Vec3 off = p.points[i] + step * p.normals[i];
+        EXPECT_NEAR(distance(r.surface, off), step, tol + 1e-3 * step);
+        EXPECT_LE(norm(closest_point(r.surface, off) - p.points[i]), 3 * tol);
+    }
+}
+
+TEST(FitBSpline, PlanesStayPlanesAndNonHeightFieldsFail) {
+    test::Rng rng(32);
+    const Patch plane = plane_patch(rng, 2000);
+    const KindSelection s =
+        fit_simplest(FitInput{plane.points, plane.normals, {}}, 1e-6 * plane.size);
+    EXPECT_EQ(s.best.surface.kind, FitKind::kPlane);
+    // A whole cylinder is no height field over any plane.
+    const Patch tube = cylinder_patch(rng, 5, 360, 20, 4000);
+    const FitResult r = fit_bspline(FitInput{tube.points, tube.normals, {}}, 1e-3 * tube.size);
+    EXPECT_FALSE(r.ok);
+    EXPECT_FALSE(r.failure.empty());
 }
 
 TEST(FitSnap, NearlyRoundValuesBecomeRoundAndTrueOnesStay) {

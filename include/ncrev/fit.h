@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -16,10 +17,11 @@
 
 namespace ncrev {
 
-/// The kinds of analytic surface fit() knows, simplest first (the order kind selection tries).
-enum class FitKind : std::uint8_t { kPlane, kSphere, kCylinder, kCone, kTorus };
-constexpr int kNumFitKinds = 5;
-/// "plane", "sphere", "cylinder", "cone", "torus" (the SRE keywords).
+/// The kinds of surface fit() knows, simplest first (the order kind selection tries); the
+/// B-spline is the free-form last resort.
+enum class FitKind : std::uint8_t { kPlane, kSphere, kCylinder, kCone, kTorus, kBSpline };
+constexpr int kNumFitKinds = 6;
+/// "plane", "sphere", "cylinder", "cone", "torus" (the SRE keywords), "bspline".
 const char* to_string(FitKind kind);
 
 /// An analytic surface. Which fields mean something depends on `kind`:
@@ -30,7 +32,9 @@ const char* to_string(FitKind kind);
 ///   of the section through `point` (>= 0), `angle` the half-angle in (0, pi/2);
 /// - torus: `point` its center, `axis` its unit axis, `radius` the major radius R (center to
 ///   tube center), `minor_radius` r.
+/// - bspline: `bspline` (below); `point` and `axis` the mean plane it is a height field over.
 /// The orientation of `axis` carries no meaning except for cones.
+struct BSplineSurface;
 struct Surface {
     FitKind kind = FitKind::kPlane;
     Vec3 point;
@@ -38,6 +42,20 @@ struct Surface {
     double radius = 0;
     double angle = 0;
     double minor_radius = 0;
+    std::shared_ptr<const BSplineSurface> bspline;  ///< kBSpline only
+};
+
+/// A non-rational B-spline surface, clamped, uniform knots on [0, 1] in both directions:
+/// poles[i + num_u * j] for i < num_u, j < num_v. Evaluation by de Boor's algorithm.
+struct BSplineSurface {
+    int degree = 3;
+    int num_u = 0, num_v = 0;
+    std::vector<Vec3> poles;
+    /// The knot vector of a direction with n poles (degree + 1 zeros and ones at the ends).
+    std::vector<double> knots(int n) const;
+    Vec3 evaluate(double u, double v) const;
+    /// Point and first derivatives.
+    void evaluate(double u, double v, Vec3& p, Vec3& du, Vec3& dv) const;
 };
 
 /// Unsigned distance from `p` to the (unbounded) surface.
@@ -67,15 +85,24 @@ struct FitResult {
 };
 
 /// Fits one kind. Cylinders, cones and tori need normals for their start (the axis is found
-/// as the line that meets every normal line); spheres and planes do not. Never throws.
+/// as the line that meets every normal line); spheres and planes do not. A B-spline is fitted
+/// to within 1e-4 of the points' extent (see fit_bspline()). Never throws.
 FitResult fit(FitKind kind, const FitInput& input);
+
+/// A cubic B-spline surface over the points' mean plane (they must be a height field over it:
+/// free-form machined regions, a die's cavity, are), by least squares with a small smoothing
+/// term that also spans cells without points; the control net starts at 4 x 4 and doubles in
+/// each direction until the max residual is within `tolerance` or the net would have more
+/// poles than a quarter of the points (or 64 x 64). `ok` false when the points are not a
+/// height field over their plane or no net reaches the tolerance.
+FitResult fit_bspline(const FitInput& input, double tolerance);
 
 /// The simplest kind whose fit keeps every point within `tolerance` (max residual), in the
 /// order plane, sphere, cylinder, cone, torus, so that a plane is not called a cylinder of huge
 /// radius, nor a cylinder a cone of tiny angle; unless a kind with more parameters fits clearly
 /// better (RMS lower by more than 10 % plus 2 % of the tolerance): then the simpler one is
-/// biased, e.g. a cylinder fitted to a narrow strip of a cone. Every kind is fitted. `best.ok`
-/// false when none fits.
+/// biased, e.g. a cylinder fitted to a narrow strip of a cone. Every analytic kind is fitted;
+/// the B-spline only when none of them fits. `best.ok` false when nothing fits.
 struct KindSelection {
     FitResult best;
     std::array<FitResult, kNumFitKinds> tried;  ///< every fit attempted, by kind

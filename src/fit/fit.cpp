@@ -15,6 +15,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -37,8 +38,89 @@ const char* to_string(FitKind kind) {
             return "cone";
         case FitKind::kTorus:
             return "torus";
+        case FitKind::kBSpline:
+            return "bspline";
     }
     return "unknown";
+}
+
+// ---------------------------------------------------------------------------------------
+// B-spline surfaces (L. Piegl and W. Tiller, "The NURBS Book", 2nd ed., algorithms A2.1-A2.3).
+
+std::vector<double> BSplineSurface::knots(int n) const {
+    std::vector<double> k;
+    const int p = degree;
+    for (int i = 0; i <= p; ++i) k.push_back(0.0);
+    const int inner = n - p - 1;
+    for (int i = 1; i <= inner; ++i) k.push_back(static_cast<double>(i) / (inner + 1));
+    for (int i = 0; i <= p; ++i) k.push_back(1.0);
+    return k;
+}
+
+namespace {
+
+constexpr int kMaxDegree = 3;
+
+/// Knot i of the clamped uniform vector of n poles and degree p.
+double knot(int i, int p, int n) {
+    return std::clamp(static_cast<double>(i - p) / (n - p), 0.0, 1.0);
+}
+
+/// The knot span of u and the p + 1 non-zero basis functions there, with their derivatives
+/// (dN may be null).
+int basis(int p, int n, double u, double* N, double* dN) {
+    u = std::clamp(u, 0.0, 1.0);
+    const int span = std::min(n - 1, p + static_cast<int>(std::floor(u * (n - p))));
+    // Triangular table of A2.2, with derivatives (A2.3, first order).
+    double ndu[kMaxDegree + 1][kMaxDegree + 1];
+    double left[kMaxDegree + 1], right[kMaxDegree + 1];
+    ndu[0][0] = 1.0;
+    for (int j = 1; j <= p; ++j) {
+        left[j] = u - knot(span + 1 - j, p, n);
+        right[j] = knot(span + j, p, n) - u;
+        double saved = 0.0;
+        for (int r = 0; r < j; ++r) {
+            ndu[j][r] = right[r + 1] + left[j - r];
+            const double temp = ndu[r][j - 1] / ndu[j][r];
+            ndu[r][j] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        ndu[j][j] = saved;
+    }
+    for (int j = 0; j <= p; ++j) N[j] = ndu[j][p];
+    if (dN) {
+        for (int r = 0; r <= p; ++r) {
+            double d = 0;
+            if (r >= 1) d += ndu[r - 1][p - 1] / ndu[p][r - 1];
+            if (r <= p - 1) d -= ndu[r][p - 1] / ndu[p][r];
+            dN[r] = p * d;
+        }
+    }
+    return span;
+}
+
+}  // namespace
+
+void BSplineSurface::evaluate(double u, double v, Vec3& p, Vec3& du, Vec3& dv) const {
+    double Nu[kMaxDegree + 1], dNu[kMaxDegree + 1], Nv[kMaxDegree + 1], dNv[kMaxDegree + 1];
+    const int su = basis(degree, num_u, u, Nu, dNu);
+    const int sv = basis(degree, num_v, v, Nv, dNv);
+    p = du = dv = Vec3{};
+    for (int b = 0; b <= degree; ++b) {
+        for (int a = 0; a <= degree; ++a) {
+            const Vec3 P =
+                poles[static_cast<std::size_t>((su - degree + a) + num_u * (sv - degree + b))];
+            p += (Nu[a] * Nv[b]) * P;
+            du += (dNu[a] * Nv[b]) * P;
+            dv += (Nu[a] * dNv[b]) * P;
+        }
+    }
+}
+
+Vec3 BSplineSurface::evaluate(double u, double v) const {
+    Vec3 p, du, dv;
+    evaluate(u, v, p, du, dv);
+    return p;
 }
 
 namespace {
@@ -55,6 +137,15 @@ constexpr double kRelativeDecrease = 1e-14;
 /// cylinder's points, a sphere to a plane's): stop refining and report no fit.
 constexpr double kRunaway = 1000.0;
 constexpr double kTorusRunaway = 100.0;
+/// B-splines: the first net (poles along the shorter side), the largest per direction, the
+/// weight of the smoothing term relative to the data (enough to bridge cells without points,
+/// far below what would bend the surface away from them), the default tolerance of fit() as a
+/// fraction of the points' extent, and the Gauss-Newton steps of a projection.
+constexpr int kBSplineStartPoles = 4;
+constexpr int kBSplineMaxPoles = 64;
+constexpr double kBSplineSmoothing = 1e-6;
+constexpr double kBSplineDefaultTolerance = 1e-4;
+constexpr int kProjectIterations = 20;
 /// Points whose second principal variance is below this fraction of the first lie on a line
 /// (to double precision): no surface is determined.
 constexpr double kCollinear = 1e-20;
@@ -582,6 +673,203 @@ FitResult fit_torus(const FitInput& in) {
     return res;
 }
 
+/// Gauss-Newton for the parameters (u, v) of the point of `b` nearest to p, from a start,
+/// kept inside [0, 1]^2.
+void project_bspline(const BSplineSurface& b, Vec3 p, double& u, double& v) {
+    for (int it = 0; it < kProjectIterations; ++it) {
+        Vec3 s, su, sv;
+        b.evaluate(u, v, s, su, sv);
+        const Vec3 r = s - p;
+        const double a = dot(su, su), c = dot(sv, sv), d = dot(su, sv);
+        const double g1 = dot(su, r), g2 = dot(sv, r);
+        const double det = a * c - d * d;
+        if (!(det > 0)) return;
+        const double du = -(c * g1 - d * g2) / det, dv = -(a * g2 - d * g1) / det;
+        const double nu = std::clamp(u + du, 0.0, 1.0), nv = std::clamp(v + dv, 0.0, 1.0);
+        const bool done = std::fabs(nu - u) < 1e-13 && std::fabs(nv - v) < 1e-13;
+        u = nu, v = nv;
+        if (done) return;
+    }
+}
+
+/// The nearest of a coarse grid of parameters: a start for project_bspline().
+void coarse_start(const BSplineSurface& b, Vec3 p, double& u, double& v) {
+    double best = std::numeric_limits<double>::infinity();
+    constexpr int kGrid = 16;
+    for (int j = 0; j <= kGrid; ++j) {
+        for (int i = 0; i <= kGrid; ++i) {
+            const double uu = static_cast<double>(i) / kGrid, vv = static_cast<double>(j) / kGrid;
+            const Vec3 q = b.evaluate(uu, vv) - p;
+            const double d2 = dot(q, q);
+            if (d2 < best) best = d2, u = uu, v = vv;
+        }
+    }
+}
+
+FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
+    FitResult fail;
+    fail.surface.kind = FitKind::kBSpline;
+    // The mean plane and the principal directions in it.
+    double total = 0;
+    const Vec3 c = centroid(in, &total);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        const Vec3 q = in.points[i] - c;
+        const Eigen::Vector3d e(q.x, q.y, q.z);
+        cov += weight(in, i) * e * e.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+    const auto col = [&](int k) {
+        const Eigen::Vector3d e = es.eigenvectors().col(k);
+        return normalized(Vec3{e(0), e(1), e(2)});
+    };
+    const Vec3 nrm = col(0), e1 = col(2), e2 = cross(nrm, e1);
+    // Parameters from the plane coordinates.
+    const std::size_t n = in.points.size();
+    std::vector<double> x(n), y(n), z(n);
+    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 q = in.points[i] - c;
+        x[i] = dot(q, e1), y[i] = dot(q, e2), z[i] = dot(q, nrm);
+        x0 = std::min(x0, x[i]), x1 = std::max(x1, x[i]);
+        y0 = std::min(y0, y[i]), y1 = std::max(y1, y[i]);
+    }
+    if (!(x1 > x0 && y1 > y0)) {
+        fail.failure = "the points span no area";
+        return fail;
+    }
+    std::vector<double> u(n), v(n);
+    for (std::size_t i = 0; i < n; ++i)
+        u[i] = (x[i] - x0) / (x1 - x0), v[i] = (y[i] - y0) / (y1 - y0);
+    // Net sizes: 4 along the shorter side to start, proportional to the extents.
+    const double aspect = (x1 - x0) / (y1 - y0);
+    int base = kBSplineStartPoles;
+    const auto max_poles =
+        static_cast<int>(std::min<std::size_t>(n / 4, kBSplineMaxPoles * kBSplineMaxPoles));
+    FitResult best = fail;
+    for (;;) {
+        const int nu =
+            std::min(kBSplineMaxPoles,
+                     std::max(4, static_cast<int>(std::lround(base * std::max(1.0, aspect)))));
+        const int nv = std::min(
+            kBSplineMaxPoles,
+            std::max(4, static_cast<int>(std::lround(base * std::max(1.0, 1.0 / aspect)))));
+        if (nu * nv > std::max(16, max_poles)) break;
+        const int m = nu * nv;
+        // Normal equations in band storage: pole (a, b) couples with (a + da, b + db), |da|,
+        // |db| <= 3.
+        constexpr int kW = 2 * kMaxDegree + 1;
+        std::vector<double> band(static_cast<std::size_t>(m) * kW * kW, 0.0),
+            rhs(static_cast<std::size_t>(m), 0.0);
+        auto entry = [&](int row, int da, int db) -> double& {
+            return band[(static_cast<std::size_t>(row) * kW +
+                         static_cast<std::size_t>(da + kMaxDegree)) *
+                            kW +
+                        static_cast<std::size_t>(db + kMaxDegree)];
+        };
+        for (std::size_t i = 0; i < n; ++i) {
+            double Nu[kMaxDegree + 1], Nv[kMaxDegree + 1];
+            const int su = basis(3, nu, u[i], Nu, nullptr) - 3,
+                      sv = basis(3, nv, v[i], Nv, nullptr) - 3;
+            const double w = weight(in, i);
+            for (int b = 0; b <= 3; ++b) {
+                for (int a = 0; a <= 3; ++a) {
+                    const int row = (su + a) + nu * (sv + b);
+                    const double fa = w * Nu[a] * Nv[b];
+                    rhs[static_cast<std::size_t>(row)] += fa * z[i];
+                    for (int bb = 0; bb <= 3; ++bb)
+                        for (int aa = 0; aa <= 3; ++aa)
+                            entry(row, aa - a, bb - b) += fa * Nu[aa] * Nv[bb];
+                }
+            }
+        }
+        // Smoothing: the squared second differences of the heights along both directions,
+        // weighted so that it is felt only where there are no points.
+        const double lambda = kBSplineSmoothing * total / m;
+        auto smooth_row = [&](int a, int b, int sa, int sb) {
+            // Difference h(a - sa) - 2 h(a) + h(a + sa) at interior poles.
+            const int idx[3] = {(a - sa) + nu * (b - sb), a + nu * b, (a + sa) + nu * (b + sb)};
+            const double coef[3] = {1, -2, 1};
+            for (int r = 0; r < 3; ++r)
+                for (int k = 0; k < 3; ++k) {
+                    const int row = idx[r];
+                    const int other = idx[k];
+                    const int da = (other % nu) - (row % nu), db = (other / nu) - (row / nu);
+                    entry(row, da, db) += lambda * coef[r] * coef[k];
+                }
+        };
+        for (int b = 0; b < nv; ++b)
+            for (int a = 1; a + 1 < nu; ++a) smooth_row(a, b, 1, 0);
+        for (int b = 1; b + 1 < nv; ++b)
+            for (int a = 0; a < nu; ++a) smooth_row(a, b, 0, 1);
+        std::vector<Eigen::Triplet<double>> trip;
+        trip.reserve(static_cast<std::size_t>(m) * kW * kW);
+        for (int row = 0; row < m; ++row) {
+            const int a = row % nu, b = row / nu;
+            for (int db = -kMaxDegree; db <= kMaxDegree; ++db)
+                for (int da = -kMaxDegree; da <= kMaxDegree; ++da) {
+                    const double val = entry(row, da, db);
+                    if (val == 0 || a + da < 0 || a + da >= nu || b + db < 0 || b + db >= nv)
+                        continue;
+                    trip.emplace_back(row, (a + da) + nu * (b + db), val);
+                }
+        }
+        Eigen::SparseMatrix<double> A(m, m);
+        A.setFromTriplets(trip.begin(), trip.end());
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(A);
+        if (solver.info() != Eigen::Success) break;
+        const Eigen::VectorXd h = solver.solve(Eigen::Map<const Eigen::VectorXd>(rhs.data(), m));
+        if (solver.info() != Eigen::Success || !h.allFinite()) break;
+        auto bs = std::make_shared<BSplineSurface>();
+        bs->num_u = nu, bs->num_v = nv;
+        bs->poles.resize(static_cast<std::size_t>(m));
+        for (int b = 0; b < nv; ++b) {
+            // Greville abscissae: x(u) stays exactly linear, so only the heights are fitted.
+            double gv = 0;
+            for (int k = 1; k <= 3; ++k) gv += knot(b + k, 3, nv);
+            gv /= 3;
+            for (int a = 0; a < nu; ++a) {
+                double gu = 0;
+                for (int k = 1; k <= 3; ++k) gu += knot(a + k, 3, nu);
+                gu /= 3;
+                bs->poles[static_cast<std::size_t>(a + nu * b)] = c + (x0 + gu * (x1 - x0)) * e1 +
+                                                                  (y0 + gv * (y1 - y0)) * e2 +
+                                                                  h(a + nu * b) * nrm;
+            }
+        }
+        // Residuals: true distances, projecting from each point's own parameters.
+        double sum = 0, mx = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            double uu = u[i], vv = v[i];
+            project_bspline(*bs, in.points[i], uu, vv);
+            const double d = norm(bs->evaluate(uu, vv) - in.points[i]);
+            sum += weight(in, i) * d * d;
+            mx = std::max(mx, d);
+        }
+        FitResult r;
+        r.ok = true;
+        r.surface.kind = FitKind::kBSpline;
+        r.surface.point = c;
+        r.surface.axis = nrm;
+        r.surface.bspline = bs;
+        r.rms = std::sqrt(sum / total);
+        r.max = mx;
+        r.iterations = nu * nv;
+        best = r;
+        if (mx <= tolerance) return r;
+        base *= 2;
+    }
+    if (best.ok) {
+        best.ok = false;
+        best.failure =
+            "no control net up to the size limit reaches the tolerance (not a height "
+            "field over its mean plane, or too few points)";
+        return best;
+    }
+    fail.failure = "the least-squares system is singular";
+    return fail;
+}
+
 }  // namespace
 
 double distance(const Surface& s, Vec3 p) { return norm(p - closest_point(s, p)); }
@@ -625,8 +913,28 @@ Vec3 closest_point(const Surface& s, Vec3 p) {
             if (t <= 0) return apex;
             return apex + t * (ca * s.axis + sa * e);
         }
+        case FitKind::kBSpline: {
+            if (!s.bspline) return p;
+            double u = 0.5, v = 0.5;
+            coarse_start(*s.bspline, p, u, v);
+            project_bspline(*s.bspline, p, u, v);
+            return s.bspline->evaluate(u, v);
+        }
     }
     return p;
+}
+
+FitResult fit_bspline(const FitInput& in, double tolerance) {
+    if (!in.weights.empty() && in.weights.size() != in.points.size()) {
+        return failed(FitKind::kBSpline, "weights and points differ in number");
+    }
+    if (in.points.size() < 16) return failed(FitKind::kBSpline, "too few points");
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        if (!finite(in.points[i]) || (!in.weights.empty() && !(in.weights[i] >= 0))) {
+            return failed(FitKind::kBSpline, "a point or weight is not a finite number");
+        }
+    }
+    return fit_bspline_impl(in, tolerance);
 }
 
 FitResult fit(FitKind kind, const FitInput& in) {
@@ -637,7 +945,7 @@ FitResult fit(FitKind kind, const FitInput& in) {
     if (!in.normals.empty() && in.normals.size() != n) {
         return failed(kind, "normals and points differ in number");
     }
-    constexpr std::size_t kMinPoints[kNumFitKinds] = {3, 4, 5, 6, 7};
+    constexpr std::size_t kMinPoints[kNumFitKinds] = {3, 4, 5, 6, 7, 16};
     if (n < kMinPoints[static_cast<int>(kind)]) return failed(kind, "too few points");
     for (std::size_t i = 0; i < n; ++i) {
         if (!finite(in.points[i]) || (!in.weights.empty() && !(in.weights[i] >= 0))) {
@@ -669,24 +977,38 @@ FitResult fit(FitKind kind, const FitInput& in) {
             return fit_cone(in);
         case FitKind::kTorus:
             return fit_torus(in);
+        case FitKind::kBSpline: {
+            Box3 box;
+            for (const Vec3& p : in.points) box.add(p);
+            return fit_bspline_impl(in, kBSplineDefaultTolerance * norm(box.max - box.min));
+        }
     }
     return failed(kind, "unknown kind");
 }
 
 KindSelection fit_simplest(const FitInput& input, double tolerance) {
     KindSelection sel;
+    constexpr int kAnalytic = static_cast<int>(FitKind::kBSpline);
     double best_rms = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < kNumFitKinds; ++k) {
+    for (int k = 0; k < kAnalytic; ++k) {
         sel.tried[static_cast<std::size_t>(k)] = fit(static_cast<FitKind>(k), input);
         const FitResult& r = sel.tried[static_cast<std::size_t>(k)];
         if (r.ok) best_rms = std::min(best_rms, r.rms);
     }
-    for (const FitResult& r : sel.tried) {
+    for (int k = 0; k < kAnalytic; ++k) {
+        const FitResult& r = sel.tried[static_cast<std::size_t>(k)];
         if (!r.ok || r.max > tolerance) continue;
         // A kind with more parameters that fits clearly better reveals a biased simpler one
         // (a narrow strip of a cone fits a cylinder within a loose tolerance, but worse).
         if (r.rms > kSignificantRms * best_rms + kRmsFloor * tolerance) continue;
         sel.best = r;
+        return sel;
+    }
+    // No analytic kind: the free-form last resort.
+    FitResult& b = sel.tried[static_cast<std::size_t>(kAnalytic)];
+    b = fit_bspline(input, tolerance);
+    if (b.ok && b.max <= tolerance) {
+        sel.best = b;
         return sel;
     }
     sel.best.failure = "no kind fits within the tolerance";
@@ -729,6 +1051,8 @@ FitResult refit_surface(const Surface& s, unsigned frozen, const FitInput& in) {
         case FitKind::kTorus:
             return refit(TorusModel{Axis::make(s.point, s.axis), s.radius, s.minor_radius}, frozen,
                          in);
+        case FitKind::kBSpline:
+            break;  // nothing to snap
     }
     return {};
 }
@@ -743,7 +1067,7 @@ std::string number(double x) {
 
 FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
                std::vector<std::string>* applied) {
-    if (!fit0.ok) return fit0;
+    if (!fit0.ok || fit0.surface.kind == FitKind::kBSpline) return fit0;
     FitResult cur = fit0;
     unsigned frozen = 0;
     auto accept = [&](const FitResult& r) { return r.ok && r.max <= o.tolerance; };
