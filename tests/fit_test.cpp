@@ -404,6 +404,14 @@ TEST(FitBSpline, PlanesStayPlanesAndNonHeightFieldsFail) {
     const FitResult r = fit_bspline(FitInput{tube.points, tube.normals, {}}, 1e-3 * tube.size);
     EXPECT_FALSE(r.ok);
     EXPECT_FALSE(r.failure.empty());
+    // A tolerance below the noise: the net grows to its limit, then the fit fails (it once
+    // looped for ever there).
+    Patch noisy = freeform_patch(rng, 20000);
+    add_noise(noisy, 0.001 * noisy.size, rng);
+    const FitResult below = fit_bspline(FitInput{noisy.points, {}, {}}, 0.001 * noisy.size);
+    EXPECT_FALSE(below.ok);
+    ASSERT_TRUE(below.surface.bspline);
+    EXPECT_EQ(below.surface.bspline->num_u * below.surface.bspline->num_v, 64 * 64);
 }
 
 TEST(FitSnap, NearlyRoundValuesBecomeRoundAndTrueOnesStay) {

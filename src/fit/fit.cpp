@@ -747,6 +747,7 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
     const auto max_poles =
         static_cast<int>(std::min<std::size_t>(n / 4, kBSplineMaxPoles * kBSplineMaxPoles));
     FitResult best = fail;
+    int last_nu = 0, last_nv = 0;  // the net stops growing at kBSplineMaxPoles
     for (;;) {
         const int nu =
             std::min(kBSplineMaxPoles,
@@ -754,7 +755,8 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
         const int nv = std::min(
             kBSplineMaxPoles,
             std::max(4, static_cast<int>(std::lround(base * std::max(1.0, 1.0 / aspect)))));
-        if (nu * nv > std::max(16, max_poles)) break;
+        if (nu * nv > std::max(16, max_poles) || (nu == last_nu && nv == last_nv)) break;
+        last_nu = nu, last_nv = nv;
         const int m = nu * nv;
         // Normal equations in band storage: pole (a, b) couples with (a + da, b + db), |da|,
         // |db| <= 3.
