@@ -56,6 +56,17 @@ const Points& patch(FitKind kind, std::size_t count) {
                 q = Vec3{25 * std::cos(a), 25 * std::sin(a), 0} + 6 * n;
                 break;
             }
+            case FitKind::kShearCylinder:
+            case FitKind::kSweptTorus: {
+                // Circle of radius 10 in z = 0 swept along a direction 20 degrees off z; the
+                // swept torus adds a tube of 3.
+                const Vec3 d{std::sin(0.35), 0, std::cos(0.35)};
+                const Vec3 t1{-10 * std::sin(a), 10 * std::cos(a), 0};
+                n = normalized(cross(t1, d));
+                q = Vec3{10 * std::cos(a), 10 * std::sin(a), 0} + 30 * (v - 0.5) * d;
+                if (kind == FitKind::kSweptTorus) q += 3 * n;
+                break;
+            }
             case FitKind::kBSpline: {
                 // A die-like free-form height field over 30 x 20 mm.
                 const double x = 30 * u, y = 20 * v;
@@ -91,7 +102,7 @@ void BM_Fit(benchmark::State& state) {
         benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_Fit)
-    ->ArgsProduct({{0, 1, 2, 3, 4, 5}, {1'000, 10'000, 100'000}})
+    ->ArgsProduct({{0, 1, 2, 3, 4, 5, 6, 7}, {1'000, 10'000, 100'000}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

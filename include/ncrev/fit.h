@@ -19,9 +19,19 @@ namespace ncrev {
 
 /// The kinds of surface fit() knows, simplest first (the order kind selection tries); the
 /// B-spline is the free-form last resort.
-enum class FitKind : std::uint8_t { kPlane, kSphere, kCylinder, kCone, kTorus, kBSpline };
-constexpr int kNumFitKinds = 6;
-/// "plane", "sphere", "cylinder", "cone", "torus" (the SRE keywords), "bspline".
+enum class FitKind : std::uint8_t {
+    kPlane,
+    kSphere,
+    kCylinder,
+    kCone,
+    kTorus,
+    kShearCylinder,
+    kSweptTorus,
+    kBSpline
+};
+constexpr int kNumFitKinds = 8;
+/// "plane", "sphere", "cylinder", "cone", "torus", "shear_cylinder", "swept_torus" (the SRE
+/// keywords), "bspline".
 const char* to_string(FitKind kind);
 
 /// An analytic surface. Which fields mean something depends on `kind`:
@@ -32,6 +42,10 @@ const char* to_string(FitKind kind);
 ///   of the section through `point` (>= 0), `angle` the half-angle in (0, pi/2);
 /// - torus: `point` its center, `axis` its unit axis, `radius` the major radius R (center to
 ///   tube center), `minor_radius` r.
+/// - shear_cylinder: the circle of center `point`, `radius`, in the plane normal to `axis`,
+///   swept along the unit `sweep` (not in that plane): an elliptic cylinder along `sweep`;
+/// - swept_torus: the torus (`point`, `axis`, `radius` R, `minor_radius` r) swept along
+///   `sweep`: the points at distance r from the shear cylinder of radius R;
 /// - bspline: `bspline` (below); `point` and `axis` the mean plane it is a height field over.
 /// The orientation of `axis` carries no meaning except for cones.
 struct BSplineSurface;
@@ -42,6 +56,7 @@ struct Surface {
     double radius = 0;
     double angle = 0;
     double minor_radius = 0;
+    Vec3 sweep{0, 0, 1};                            ///< kShearCylinder, kSweptTorus
     std::shared_ptr<const BSplineSurface> bspline;  ///< kBSpline only
 };
 
@@ -101,8 +116,9 @@ FitResult fit_bspline(const FitInput& input, double tolerance);
 /// order plane, sphere, cylinder, cone, torus, so that a plane is not called a cylinder of huge
 /// radius, nor a cylinder a cone of tiny angle; unless a kind with more parameters fits clearly
 /// better (RMS lower by more than 10 % plus 2 % of the tolerance): then the simpler one is
-/// biased, e.g. a cylinder fitted to a narrow strip of a cone. Every analytic kind is fitted;
-/// the B-spline only when none of them fits. `best.ok` false when nothing fits.
+/// biased, e.g. a cylinder fitted to a narrow strip of a cone. Kinds are tried in rounds: plane
+/// to torus; then shear cylinder and swept torus, only when none of those fits; then the
+/// B-spline. `best.ok` false when nothing fits.
 struct KindSelection {
     FitResult best;
     std::array<FitResult, kNumFitKinds> tried;  ///< every fit attempted, by kind

@@ -38,6 +38,10 @@ const char* to_string(FitKind kind) {
             return "cone";
         case FitKind::kTorus:
             return "torus";
+        case FitKind::kShearCylinder:
+            return "shear_cylinder";
+        case FitKind::kSweptTorus:
+            return "swept_torus";
         case FitKind::kBSpline:
             return "bspline";
     }
@@ -146,6 +150,15 @@ constexpr int kBSplineMaxPoles = 64;
 constexpr double kBSplineSmoothing = 1e-6;
 constexpr double kBSplineDefaultTolerance = 1e-4;
 constexpr int kProjectIterations = 20;
+/// Shear cylinder start: the circle made slightly elliptic, so that the ellipse's turn has a
+/// derivative to follow.
+constexpr double kEllipseSeed = 1e-3;
+/// A shear cylinder's sweep makes at most 80 degrees with the circle's normal (the SRE format
+/// excludes a sweep in the circle's plane): a flatter ellipse is a plate, which straddles the
+/// noise of a plane and would "fit" it better than the plane does.
+constexpr double kMinShearCos = 0.17364817766693041;  // cos(80 degrees)
+/// Swept torus start: tube radii tried, as fractions k / kSweptStarts of the smaller semi-axis.
+constexpr int kSweptStarts = 16;
 /// Points whose second principal variance is below this fraction of the first lie on a line
 /// (to double precision): no surface is determined.
 constexpr double kCollinear = 1e-20;
@@ -351,6 +364,190 @@ struct TorusModel {
         s.axis = a.d;
         s.radius = R;
         s.minor_radius = r;
+        return s;
+    }
+};
+
+/// The point of the ellipse x^2/A^2 + y^2/B^2 = 1 (A >= B > 0) nearest to (x, y), by
+/// bisection on the Lagrange parameter (D. Eberly, "Distance from a point to an ellipse",
+/// 2013): robust everywhere, also on the axes and at the center.
+void nearest_on_ellipse(double A, double B, double x, double y, double& ex, double& ey) {
+    const double sx = x < 0 ? -1.0 : 1.0, sy = y < 0 ? -1.0 : 1.0;
+    x = std::fabs(x), y = std::fabs(y);
+    if (y > 0) {
+        if (x > 0) {
+            // F(t) = (A x / (t + A^2))^2 + (B y / (t + B^2))^2 - 1, decreasing for t > -B^2.
+            const double a2 = A * A, b2 = B * B;
+            double lo = -b2 + B * y, hi = -b2 + std::sqrt(a2 * x * x + b2 * y * y);
+            for (int it = 0; it < 200 && hi - lo > 1e-15 * (std::fabs(hi) + b2); ++it) {
+                const double t = 0.5 * (lo + hi);
+                const double f1 = A * x / (t + a2), f2 = B * y / (t + b2);
+                if (f1 * f1 + f2 * f2 - 1 > 0) {
+                    lo = t;
+                } else {
+                    hi = t;
+                }
+            }
+            const double t = 0.5 * (lo + hi);
+            ex = a2 * x / (t + a2), ey = b2 * y / (t + b2);
+        } else {
+            ex = 0, ey = B;
+        }
+    } else {
+        const double d = A * A - B * B;
+        if (x * A < d) {
+            ex = A * A * x / d;
+            ey = B * std::sqrt(std::max(0.0, 1 - (ex / A) * (ex / A)));
+        } else {
+            ex = A, ey = 0;
+        }
+    }
+    ex *= sx, ey *= sy;
+}
+
+/// An elliptic cylinder: axis through c along unit d, semi-axis A along the unit w (normal to
+/// d) and B along m = d x w. The signed distance is positive outside.
+struct EllipticCylinder {
+    Vec3 c, d, w;
+    double A, B;
+    /// Signed distance of p, its local coordinates, the nearest ellipse point and the unit
+    /// outward normal there (local).
+    double signed_distance(Vec3 p, double& x, double& y, double& ex, double& ey, double& nx,
+                           double& ny, double& h) const {
+        const Vec3 q = p - c;
+        h = dot(q, d);
+        const Vec3 m = cross(d, w);
+        x = dot(q, w), y = dot(q, m);
+        const double a = std::max(std::fabs(A), std::fabs(B)),
+                     b = std::min(std::fabs(A), std::fabs(B));
+        // Work with the larger semi-axis along the first coordinate.
+        const bool swap = std::fabs(B) > std::fabs(A);
+        double lx = swap ? y : x, ly = swap ? x : y, lex, ley;
+        nearest_on_ellipse(a, std::max(b, 1e-300), lx, ly, lex, ley);
+        ex = swap ? ley : lex, ey = swap ? lex : ley;
+        const double dx = x - ex, dy = y - ey;
+        const double dist = std::sqrt(dx * dx + dy * dy);
+        const bool outside = (x * x) / (A * A) + (y * y) / (B * B) > 1;
+        if (dist > 0) {
+            nx = dx / dist, ny = dy / dist;
+            if (!outside) nx = -nx, ny = -ny;
+        } else {
+            const double gx = ex / (A * A), gy = ey / (B * B), gl = std::hypot(gx, gy);
+            nx = gl > 0 ? gx / gl : 1, ny = gl > 0 ? gy / gl : 0;
+        }
+        return outside ? dist : -dist;
+    }
+    /// Derivatives of the signed distance by (cu, cv, du, dv, A, B, phi), u, v the frame of d.
+    void gradient(Vec3 u, Vec3 v, double x, double y, double ex, double ey, double nx, double ny,
+                  double h, double* J) const {
+        const Vec3 m = cross(d, w);
+        // The center moves across the axis: the point moves the other way in the section.
+        J[0] = -(nx * dot(u, w) + ny * dot(u, m));
+        J[1] = -(nx * dot(v, w) + ny * dot(v, m));
+        // The axis tips: the section of p moves by -h times the tip.
+        J[2] = -h * (nx * dot(u, w) + ny * dot(u, m));
+        J[3] = -h * (nx * dot(v, w) + ny * dot(v, m));
+        J[4] = -nx * (A != 0 ? ex / A : 0);
+        J[5] = -ny * (B != 0 ? ey / B : 0);
+        J[6] = nx * y - ny * x;  // turning w towards m turns the point the other way
+    }
+    EllipticCylinder stepped(const Axis& a, const double* s) const {
+        const Axis moved = a.stepped(s[0], s[1], s[2], s[3]);
+        const Vec3 m = cross(d, w);
+        Vec3 nw = w + s[6] * m;                            // turned about d
+        nw = normalized(nw - dot(nw, moved.d) * moved.d);  // and kept normal to the new axis
+        return {moved.c, moved.d, nw, A + s[4], B + s[5]};
+    }
+};
+
+struct ShearModel {
+    static constexpr int N = 7;
+    EllipticCylinder e;
+    Axis frame() const { return Axis::make(e.c, e.d); }
+    double residual(Vec3 p, double* J) const {
+        double x, y, ex, ey, nx, ny, h;
+        const double s = e.signed_distance(p, x, y, ex, ey, nx, ny, h);
+        if (J) {
+            const Axis a = frame();
+            e.gradient(a.u, a.v, x, y, ex, ey, nx, ny, h, J);
+        }
+        return s;
+    }
+    ShearModel stepped(const double* d) const { return {e.stepped(frame(), d)}; }
+    bool runaway(double extent) const {
+        return std::fabs(e.A) > kRunaway * extent || std::fabs(e.B) > kRunaway * extent;
+    }
+    Surface surface() const;
+};
+
+/// The circle behind an elliptic cylinder: radius A (the larger semi-axis), in the plane that
+/// cuts it in a circle. Of the two such planes, the one whose normal is nearer a coordinate
+/// axis (tool axes are).
+void circle_of(const EllipticCylinder& e, double& radius, Vec3& normal, Vec3& sweep) {
+    Vec3 w = e.w;
+    double A = std::fabs(e.A), B = std::fabs(e.B);
+    if (B > A) {
+        std::swap(A, B);
+        w = cross(e.d, w);
+    }
+    const Vec3 m = cross(e.d, w);
+    const double cg = A > 0 ? B / A : 1, sg = std::sqrt(std::max(0.0, 1 - cg * cg));
+    const Vec3 n1 = cg * e.d + sg * m, n2 = cg * e.d - sg * m;
+    auto axial = [](Vec3 n) { return std::max({std::fabs(n.x), std::fabs(n.y), std::fabs(n.z)}); };
+    normal = axial(n1) >= axial(n2) ? n1 : n2;
+    radius = A;
+    sweep = e.d;
+}
+
+Surface ShearModel::surface() const {
+    Surface s;
+    s.kind = FitKind::kShearCylinder;
+    s.point = e.c;
+    circle_of(e, s.radius, s.axis, s.sweep);
+    return s;
+}
+
+/// The elliptic cylinder of a shear cylinder (c, a, r, d).
+EllipticCylinder elliptic_of(Vec3 c, Vec3 a, double r, Vec3 d) {
+    d = normalized(d);
+    a = normalized(a);
+    Vec3 w = cross(a, d);
+    if (norm(w) < 1e-12) {
+        Vec3 v;
+        frame(d, w, v);  // a circular cylinder: any direction
+    }
+    w = normalized(w);
+    return {c, d, w, r, r * std::fabs(dot(a, d))};
+}
+
+/// Swept torus: the elliptic cylinder of its tube centers and the tube radius. A fitted patch
+/// lies on one sheet of the envelope: the residual is s - r, signed (r < 0 for the inner
+/// sheet). Measuring |s| - r instead would let two sheets straddle the noise of any surface.
+struct SweptModel {
+    static constexpr int N = 8;
+    EllipticCylinder e;
+    double r;
+    Axis frame() const { return Axis::make(e.c, e.d); }
+    double residual(Vec3 p, double* J) const {
+        double x, y, ex, ey, nx, ny, h;
+        const double s = e.signed_distance(p, x, y, ex, ey, nx, ny, h);
+        if (J) {
+            const Axis a = frame();
+            e.gradient(a.u, a.v, x, y, ex, ey, nx, ny, h, J);
+            J[7] = -1;
+        }
+        return s - r;
+    }
+    SweptModel stepped(const double* d) const { return {e.stepped(frame(), d), r + d[7]}; }
+    bool runaway(double extent) const {
+        return std::fabs(e.A) > kRunaway * extent || std::fabs(r) > kRunaway * extent;
+    }
+    Surface surface() const {
+        Surface s;
+        s.kind = FitKind::kSweptTorus;
+        s.point = e.c;
+        circle_of(e, s.radius, s.axis, s.sweep);
+        s.minor_radius = std::fabs(r);
         return s;
     }
 };
@@ -872,6 +1069,109 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
     return fail;
 }
 
+FitResult fit_shear_cylinder(const FitInput& in) {
+    // Start: the circular cylinder (its axis from the normals is the sweep direction: the
+    // normals of any cylinder along d are normal to d), then let the section become an ellipse.
+    const FitResult cyl = fit_cylinder(in);
+    if (!cyl.ok) return failed(FitKind::kShearCylinder, cyl.failure);
+    const Axis a = Axis::make(cyl.surface.point, cyl.surface.axis);
+    ShearModel m{{a.c, a.d, a.u, cyl.surface.radius * (1 + kEllipseSeed), cyl.surface.radius}};
+    const int it = refine(m, in);
+    FitResult res = finish(m, it, in);
+    const double ratio =
+        std::min(std::fabs(m.e.A), std::fabs(m.e.B)) / std::max(std::fabs(m.e.A), std::fabs(m.e.B));
+    if (res.ok && !(ratio >= kMinShearCos)) {
+        res.ok = false;
+        res.failure = "the sweep lies (almost) in the circle's plane: no shear cylinder";
+    }
+    return res;
+}
+
+/// How far the points q_i = p_i - r n_i (the tube centers, for the right r) are from lying on
+/// one ellipse in the section normal to d: the relative residual of the algebraic conic
+/// x^2 + b xy + c y^2 + d x + e y + f = 0 fitted by least squares.
+double conic_misfit(const FitInput& in, Vec3 dir, double r) {
+    Vec3 u, v;
+    frame(dir, u, v);
+    const Vec3 g = centroid(in);
+    Eigen::Matrix<double, 5, 5> ata = Eigen::Matrix<double, 5, 5>::Zero();
+    Eigen::Matrix<double, 5, 1> atb = Eigen::Matrix<double, 5, 1>::Zero();
+    double scale = 0;
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        const Vec3 q = in.points[i] - r * in.normals[i] - g;
+        const double x = dot(q, u), y = dot(q, v);
+        scale = std::max(scale, x * x + y * y);
+    }
+    if (!(scale > 0)) return std::numeric_limits<double>::infinity();
+    double bb = 0;
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        const Vec3 q = in.points[i] - r * in.normals[i] - g;
+        const double x = dot(q, u) / std::sqrt(scale), y = dot(q, v) / std::sqrt(scale);
+        Eigen::Matrix<double, 5, 1> row;
+        row << x * y, y * y, x, y, 1.0;
+        const double w = weight(in, i);
+        ata += w * row * row.transpose();
+        atb -= w * (x * x) * row;
+        bb += w * x * x * x * x;
+    }
+    const Eigen::Matrix<double, 5, 1> sol = ata.ldlt().solve(atb);
+    // Residual sum of squares of rows . sol = -x^2: b.b - sol . A^T b at the optimum, with
+    // A^T b = atb.
+    const double rss = bb - sol.dot(atb);
+    return std::max(rss, 0.0) / std::max(bb, 1e-300);
+}
+
+FitResult fit_swept_torus(const FitInput& in) {
+    // Start: the sweep direction from a shear-cylinder fit (the normals are normal to it),
+    // then the tube radius r as the offset along the normals that brings the points onto one
+    // ellipse (golden-section search on the conic misfit), then the ellipse of the tube
+    // centers.
+    if (in.normals.size() != in.points.size()) {
+        return failed(FitKind::kSweptTorus, "the normals are needed for the tube radius");
+    }
+    const FitResult shear = fit_shear_cylinder(in);
+    if (!shear.ok) return failed(FitKind::kSweptTorus, shear.failure);
+    const Vec3 dir = shear.surface.sweep;
+    const EllipticCylinder e0 = elliptic_of(shear.surface.point, shear.surface.axis,
+                                            shear.surface.radius, shear.surface.sweep);
+    const double bmin = std::min(std::fabs(e0.A), std::fabs(e0.B));
+    // Coarse scan for the basin (the misfit need not be unimodal), then golden section.
+    double best_r = 0, best = std::numeric_limits<double>::infinity();
+    for (int k = 1; k < kSweptStarts; ++k) {
+        const double r = bmin * k / kSweptStarts;
+        const double f = conic_misfit(in, dir, r);
+        if (f < best) best = f, best_r = r;
+    }
+    double lo = std::max(0.0, best_r - bmin / kSweptStarts), hi = best_r + bmin / kSweptStarts;
+    constexpr double kGolden = 0.6180339887498949;
+    for (int it = 0; it < 60; ++it) {
+        const double a = hi - kGolden * (hi - lo), b = lo + kGolden * (hi - lo);
+        if (conic_misfit(in, dir, a) < conic_misfit(in, dir, b)) {
+            hi = b;
+        } else {
+            lo = a;
+        }
+    }
+    const double r0 = 0.5 * (lo + hi);
+    // The tube centers' elliptic cylinder, as a shear cylinder fit of the shifted points.
+    std::vector<Vec3> centers(in.points.size());
+    for (std::size_t i = 0; i < centers.size(); ++i) centers[i] = in.points[i] - r0 * in.normals[i];
+    const FitResult core = fit_shear_cylinder(FitInput{centers, in.normals, in.weights});
+    if (!core.ok) return failed(FitKind::kSweptTorus, core.failure);
+    SweptModel m{
+        elliptic_of(core.surface.point, core.surface.axis, core.surface.radius, core.surface.sweep),
+        r0};
+    const int it = refine(m, in);
+    FitResult res = finish(m, it, in);
+    const double ratio =
+        std::min(std::fabs(m.e.A), std::fabs(m.e.B)) / std::max(std::fabs(m.e.A), std::fabs(m.e.B));
+    if (res.ok && !(m.r != 0 && ratio >= kMinShearCos)) {
+        res.ok = false;
+        res.failure = "the radii left their range";
+    }
+    return res;
+}
+
 }  // namespace
 
 double distance(const Surface& s, Vec3 p) { return norm(p - closest_point(s, p)); }
@@ -915,6 +1215,18 @@ Vec3 closest_point(const Surface& s, Vec3 p) {
             if (t <= 0) return apex;
             return apex + t * (ca * s.axis + sa * e);
         }
+        case FitKind::kShearCylinder:
+        case FitKind::kSweptTorus: {
+            const EllipticCylinder e = elliptic_of(s.point, s.axis, s.radius, s.sweep);
+            double x, y, ex, ey, nx, ny, h;
+            e.signed_distance(p, x, y, ex, ey, nx, ny, h);
+            const Vec3 m = cross(e.d, e.w);
+            const Vec3 on = e.c + h * e.d + ex * e.w + ey * m;
+            if (s.kind == FitKind::kShearCylinder) return on;
+            const Vec3 out = p - on;
+            const double lo = norm(out);
+            return on + s.minor_radius * (lo > 0 ? out / lo : nx * e.w + ny * m);
+        }
         case FitKind::kBSpline: {
             if (!s.bspline) return p;
             double u = 0.5, v = 0.5;
@@ -947,7 +1259,7 @@ FitResult fit(FitKind kind, const FitInput& in) {
     if (!in.normals.empty() && in.normals.size() != n) {
         return failed(kind, "normals and points differ in number");
     }
-    constexpr std::size_t kMinPoints[kNumFitKinds] = {3, 4, 5, 6, 7, 16};
+    constexpr std::size_t kMinPoints[kNumFitKinds] = {3, 4, 5, 6, 7, 8, 9, 16};
     if (n < kMinPoints[static_cast<int>(kind)]) return failed(kind, "too few points");
     for (std::size_t i = 0; i < n; ++i) {
         if (!finite(in.points[i]) || (!in.weights.empty() && !(in.weights[i] >= 0))) {
@@ -979,6 +1291,10 @@ FitResult fit(FitKind kind, const FitInput& in) {
             return fit_cone(in);
         case FitKind::kTorus:
             return fit_torus(in);
+        case FitKind::kShearCylinder:
+            return fit_shear_cylinder(in);
+        case FitKind::kSweptTorus:
+            return fit_swept_torus(in);
         case FitKind::kBSpline: {
             Box3 box;
             for (const Vec3& p : in.points) box.add(p);
@@ -990,28 +1306,28 @@ FitResult fit(FitKind kind, const FitInput& in) {
 
 KindSelection fit_simplest(const FitInput& input, double tolerance) {
     KindSelection sel;
-    constexpr int kAnalytic = static_cast<int>(FitKind::kBSpline);
-    double best_rms = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < kAnalytic; ++k) {
-        sel.tried[static_cast<std::size_t>(k)] = fit(static_cast<FitKind>(k), input);
-        const FitResult& r = sel.tried[static_cast<std::size_t>(k)];
-        if (r.ok) best_rms = std::min(best_rms, r.rms);
-    }
-    for (int k = 0; k < kAnalytic; ++k) {
-        const FitResult& r = sel.tried[static_cast<std::size_t>(k)];
-        if (!r.ok || r.max > tolerance) continue;
-        // A kind with more parameters that fits clearly better reveals a biased simpler one
-        // (a narrow strip of a cone fits a cylinder within a loose tolerance, but worse).
-        if (r.rms > kSignificantRms * best_rms + kRmsFloor * tolerance) continue;
-        sel.best = r;
-        return sel;
-    }
-    // No analytic kind: the free-form last resort.
-    FitResult& b = sel.tried[static_cast<std::size_t>(kAnalytic)];
-    b = fit_bspline(input, tolerance);
-    if (b.ok && b.max <= tolerance) {
-        sel.best = b;
-        return sel;
+    // Rounds of kinds: the surfaces of revolution first; the sheared kinds only when none of
+    // those fits; the B-spline last. Within a round, the simplest passing kind wins unless a
+    // richer one of the round fits clearly better.
+    constexpr int kRounds[][2] = {{0, 5}, {5, 7}, {7, 8}};
+    for (const auto& round : kRounds) {
+        double best_rms = std::numeric_limits<double>::infinity();
+        for (int k = round[0]; k < round[1]; ++k) {
+            const auto kind = static_cast<FitKind>(k);
+            sel.tried[static_cast<std::size_t>(k)] =
+                kind == FitKind::kBSpline ? fit_bspline(input, tolerance) : fit(kind, input);
+            const FitResult& r = sel.tried[static_cast<std::size_t>(k)];
+            if (r.ok) best_rms = std::min(best_rms, r.rms);
+        }
+        for (int k = round[0]; k < round[1]; ++k) {
+            const FitResult& r = sel.tried[static_cast<std::size_t>(k)];
+            if (!r.ok || r.max > tolerance) continue;
+            // A kind with more parameters that fits clearly better reveals a biased simpler one
+            // (a narrow strip of a cone fits a cylinder within a loose tolerance, but worse).
+            if (r.rms > kSignificantRms * best_rms + kRmsFloor * tolerance) continue;
+            sel.best = r;
+            return sel;
+        }
     }
     sel.best.failure = "no kind fits within the tolerance";
     return sel;
@@ -1053,8 +1369,10 @@ FitResult refit_surface(const Surface& s, unsigned frozen, const FitInput& in) {
         case FitKind::kTorus:
             return refit(TorusModel{Axis::make(s.point, s.axis), s.radius, s.minor_radius}, frozen,
                          in);
+        case FitKind::kShearCylinder:
+        case FitKind::kSweptTorus:
         case FitKind::kBSpline:
-            break;  // nothing to snap
+            break;  // not snapped (yet)
     }
     return {};
 }
@@ -1069,7 +1387,10 @@ std::string number(double x) {
 
 FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
                std::vector<std::string>* applied) {
-    if (!fit0.ok || fit0.surface.kind == FitKind::kBSpline) return fit0;
+    if (!fit0.ok || fit0.surface.kind == FitKind::kBSpline ||
+        fit0.surface.kind == FitKind::kShearCylinder || fit0.surface.kind == FitKind::kSweptTorus) {
+        return fit0;
+    }
     FitResult cur = fit0;
     unsigned frozen = 0;
     auto accept = [&](const FitResult& r) { return r.ok && r.max <= o.tolerance; };
