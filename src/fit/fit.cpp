@@ -368,27 +368,28 @@ struct TorusModel {
     }
 };
 
-/// The point of the ellipse x^2/A^2 + y^2/B^2 = 1 (A >= B > 0) nearest to (x, y), by
-/// bisection on the Lagrange parameter (D. Eberly, "Distance from a point to an ellipse",
-/// 2013): robust everywhere, also on the axes and at the center.
+/// The point of the ellipse x^2/A^2 + y^2/B^2 = 1 (A >= B > 0) nearest to (x, y), by a
+/// monotone Newton iteration on the Lagrange parameter (after D. Eberly, "Distance from a
+/// point to an ellipse", 2013): robust everywhere, also on the axes and at the center.
 void nearest_on_ellipse(double A, double B, double x, double y, double& ex, double& ey) {
     const double sx = x < 0 ? -1.0 : 1.0, sy = y < 0 ? -1.0 : 1.0;
     x = std::fabs(x), y = std::fabs(y);
     if (y > 0) {
         if (x > 0) {
-            // F(t) = (A x / (t + A^2))^2 + (B y / (t + B^2))^2 - 1, decreasing for t > -B^2.
+            // F(t) = (A x / (t + A^2))^2 + (B y / (t + B^2))^2 - 1 is convex and decreasing for
+            // t > -B^2, and F(t0) >= 0 at t0 = -B^2 + B y: Newton from t0 climbs to the root
+            // from below without overshooting (the tangent of a convex function lies below it).
             const double a2 = A * A, b2 = B * B;
-            double lo = -b2 + B * y, hi = -b2 + std::sqrt(a2 * x * x + b2 * y * y);
-            for (int it = 0; it < 200 && hi - lo > 1e-15 * (std::fabs(hi) + b2); ++it) {
-                const double t = 0.5 * (lo + hi);
-                const double f1 = A * x / (t + a2), f2 = B * y / (t + b2);
-                if (f1 * f1 + f2 * f2 - 1 > 0) {
-                    lo = t;
-                } else {
-                    hi = t;
-                }
+            double t = -b2 + B * y;
+            for (int it = 0; it < 100; ++it) {
+                const double pa = A * x / (t + a2), pb = B * y / (t + b2);
+                const double f = pa * pa + pb * pb - 1;
+                if (!(f > 0)) break;
+                const double df = -2 * (pa * pa / (t + a2) + pb * pb / (t + b2));
+                const double step = -f / df;
+                t += step;
+                if (!(step > 1e-16 * (std::fabs(t) + b2))) break;
             }
-            const double t = 0.5 * (lo + hi);
             ex = a2 * x / (t + a2), ey = b2 * y / (t + b2);
         } else {
             ex = 0, ey = B;
