@@ -75,12 +75,6 @@ void add_curvature(CLI::App& app, Context& ctx) {
     cmd->add_flag("-q,--quiet", o->quiet, "No warnings and no progress on stderr");
     cmd->callback([o, cmd, &ctx]() {
         const std::filesystem::path in(o->input), out(o->output);
-        std::error_code ec;
-        if (std::filesystem::exists(out, ec) && std::filesystem::equivalent(in, out, ec)) {
-            print_error(o->output + ": is the input; ncrev never overwrites its input");
-            ctx.exit_code = kExitUsage;
-            return;
-        }
         if (o->neighbourhood == Neighbourhood::kGeodesic && o->radius <= 0) {
             print_error("--neighbourhood geodesic needs --radius");
             ctx.exit_code = kExitUsage;
@@ -91,13 +85,9 @@ void add_curvature(CLI::App& app, Context& ctx) {
             ctx.exit_code = kExitUsage;
             return;
         }
+        auto healed = read_input(in, out, ctx, o->quiet);
+        if (!healed) return;
         const auto progress = terminal_progress(ctx, o->quiet);
-        auto healed = read_and_heal(in, {}, progress);
-        if (!healed) {
-            print_error(healed.error().describe());
-            ctx.exit_code = kExitBadInput;
-            return;
-        }
         if (healed->mesh.num_faces() == 0) {
             print_error(o->input + ": no facet left after healing; nothing to estimate");
             ctx.exit_code = kExitNoResult;

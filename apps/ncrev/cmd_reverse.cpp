@@ -19,11 +19,6 @@ struct ReverseCliOptions {
     bool quiet = false;
 };
 
-bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
-    std::error_code ec;
-    return std::filesystem::exists(b, ec) && std::filesystem::equivalent(a, b, ec);
-}
-
 void add_reverse(CLI::App& app, Context& ctx) {
     auto o = std::make_shared<ReverseCliOptions>();
     CLI::App* cmd = app.add_subcommand(
@@ -56,18 +51,9 @@ void add_reverse(CLI::App& app, Context& ctx) {
     cmd->add_flag("-q,--quiet", o->quiet, "No warnings and no progress on stderr");
     cmd->callback([o, &ctx]() {
         const std::filesystem::path in(o->input), out(o->output);
-        if (same_file(in, out)) {
-            print_error(o->output + ": is the input; ncrev never overwrites its input");
-            ctx.exit_code = kExitUsage;
-            return;
-        }
+        auto healed = read_input(in, out, ctx, o->quiet);
+        if (!healed) return;
         const auto progress = terminal_progress(ctx, o->quiet);
-        auto healed = read_and_heal(in, {}, progress);
-        if (!healed) {
-            print_error(healed.error().describe());
-            ctx.exit_code = kExitBadInput;
-            return;
-        }
         if (o->require_solid && !healed->report.mesh.closed) {
             print_error(o->input + ": the mesh is open (" +
                         std::to_string(healed->report.mesh.boundary_loops) +

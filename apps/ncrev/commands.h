@@ -4,10 +4,14 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "ncrev/report.h"
 
 namespace ncrev::cli {
 
@@ -45,5 +49,11 @@ std::function<void(std::string_view stage, double fraction)> terminal_progress(c
 void print_error(const std::string& message);
 /// Prints "warning: <message>" to stderr.
 void print_warning(const std::string& message);
+
+/// The start of every command that turns an input mesh into an output file: refuses an output
+/// that is the input (exit 1), then reads and heals the input (exit 2 on a reader error, with
+/// the error printed). Empty when the command must stop; ctx.exit_code is then set.
+std::optional<HealedMesh> read_input(const std::filesystem::path& input,
+                                     const std::filesystem::path& output, Context& ctx, bool quiet);
 
 }  // namespace ncrev::cli

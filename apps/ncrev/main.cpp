@@ -44,6 +44,24 @@ std::function<void(std::string_view, double)> terminal_progress(const Context& c
 void print_error(const std::string& message) {
     std::fprintf(stderr, "error: %s\n", message.c_str());
 }
+std::optional<HealedMesh> read_input(const std::filesystem::path& input,
+                                     const std::filesystem::path& output, Context& ctx,
+                                     bool quiet) {
+    std::error_code ec;
+    if (std::filesystem::exists(output, ec) && std::filesystem::equivalent(input, output, ec)) {
+        print_error(output.string() + ": is the input; ncrev never overwrites its input");
+        ctx.exit_code = kExitUsage;
+        return std::nullopt;
+    }
+    auto healed = read_and_heal(input, {}, terminal_progress(ctx, quiet));
+    if (!healed) {
+        print_error(healed.error().describe());
+        ctx.exit_code = kExitBadInput;
+        return std::nullopt;
+    }
+    return std::move(healed).value();
+}
+
 void print_warning(const std::string& message) {
     std::fprintf(stderr, "warning: %s\n", message.c_str());
 }

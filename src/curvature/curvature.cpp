@@ -453,7 +453,7 @@ void geodesic_neighbourhood(const Mesh& m, const std::vector<VertexData>& data, 
 
 /// The weighted tensor of method.md 3.1 over the cells in s.set, relative to p's normal.
 Sym3 weighted_tensor(const Mesh& m, const FaceMap<Vec3>& face_normal, Vec3 np, const Scratch& s) {
-    Sym3 sum;
+    Sym3 sum, plain;
     double lambda_sum = 0;
     std::size_t count = 0;
     for (const std::uint32_t qi : s.set) {
@@ -471,30 +471,13 @@ Sym3 weighted_tensor(const Mesh& m, const FaceMap<Vec3>& face_normal, Vec3 np, c
                 std::atan2(dot(cross(n1, n2), e), std::clamp(dot(n1, n2), -1.0, 1.0));
             const double lambda = std::acos(std::clamp(dot(np, normalized(n1 + n2)), -1.0, 1.0));
             sum.add_outer(e, lambda * beta * 0.5 * lu);
+            plain.add_outer(e, beta * 0.5 * lu);
             lambda_sum += lambda;
             ++count;
         });
     }
-    if (lambda_sum <= 0) {
-        // Every edge normal parallel to the vertex normal: all weights equal, i.e. 1.
-        Sym3 plain;
-        for (const std::uint32_t qi : s.set) {
-            const VertexId q(qi);
-            const Vec3 pq = m.position(q);
-            for_each_outgoing(m, q, [&](HalfedgeId h) {
-                const HalfedgeId t = m.twin(h);
-                if (!t.is_valid()) return;
-                const Vec3 u = m.position(m.target(h)) - pq;
-                const double lu = norm(u);
-                if (lu <= 0) return;
-                const Vec3 n1 = face_normal[Mesh::face(h)], n2 = face_normal[Mesh::face(t)];
-                const double beta =
-                    std::atan2(dot(cross(n1, n2), u / lu), std::clamp(dot(n1, n2), -1.0, 1.0));
-                plain.add_outer(u / lu, beta * 0.5 * lu);
-            });
-        }
-        return plain;
-    }
+    // Every edge normal parallel to the vertex normal: all weights equal, i.e. 1.
+    if (lambda_sum <= 0) return plain;
     // Rescale so that the weights average 1 over the edges (method.md 3.1).
     const double scale = static_cast<double>(count) / lambda_sum;
     for (double& x : sum.v) x *= scale;
