@@ -310,6 +310,39 @@ TEST(Fit, DistanceAndClosestPointAgree) {
     }
 }
 
+TEST(Fit, InvariantUnderRigidMotion) {
+    test::Rng rng(17);
+    const Vec3 turn{0.2, -0.7, 0.4};
+    const double angle = 1.1;
+    const Vec3 shift{-40, 25, 60};
+    for (Patch p : target_patches(rng)) {
+        add_noise(p, 0.001 * p.size, rng);
+        const FitResult a = fit_patch(p);
+        Patch moved = p;
+        for (Vec3& q : moved.points) q = rotate(q, turn, angle) + shift;
+        for (Vec3& n : moved.normals) n = rotate(n, turn, angle);
+        const FitResult b = fit_patch(moved);
+        ASSERT_TRUE(a.ok && b.ok) << p.name;
+        // Equal to the convergence of the refinement (its stopping rule leaves ~1e-7).
+        const double tol = 1e-6 * p.size;
+        EXPECT_NEAR(b.surface.radius, a.surface.radius, tol) << p.name;
+        EXPECT_NEAR(b.surface.minor_radius, a.surface.minor_radius, tol) << p.name;
+        EXPECT_NEAR(b.surface.angle, a.surface.angle, 1e-6) << p.name;
+        EXPECT_NEAR(b.rms, a.rms, tol) << p.name;
+        if (p.truth.kind != FitKind::kSphere) {
+            EXPECT_LE(axis_angle_deg(b.surface.axis, rotate(a.surface.axis, turn, angle),
+                                     p.truth.kind == FitKind::kCone),
+                      1e-4)
+                << p.name;
+        }
+        // The same surface: every moved point at the same distance.
+        for (std::size_t i = 0; i < 20; ++i) {
+            EXPECT_NEAR(distance(b.surface, moved.points[i]), distance(a.surface, p.points[i]),
+                        tol);
+        }
+    }
+}
+
 TEST(Fit, DegenerateInputFailsCleanly) {
     const std::vector<Vec3> line = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0},
                                     {4, 0, 0}, {5, 0, 0}, {6, 0, 0}, {7, 0, 0}};
@@ -546,6 +579,57 @@ TEST(FitSnap, NearlyRoundValuesBecomeRoundAndTrueOnesStay) {
     applied.clear();
     const FitResult tool = snap(f, in, o, &applied);
     EXPECT_EQ(tool.surface.radius, 10.025);
+}
+
+TEST(FitSnap, CounterboreAndHoleBecomeCoaxialAndTheShoulderParallel) {
+    // A hole (r 5, z in [0, 10]), its counterbore (r 8, z in [10, 14]) and the shoulder ring
+    // between them (z = 10), along an axis tilted off the coordinate axes, with noise.
+    test::Rng rng(51);
+    const Vec3 axis = normalized(Vec3{0.3, -0.2, 1.0});
+    Vec3 u, v;
+    u = normalized(cross(axis, Vec3{1, 0, 0}));
+    v = cross(axis, u);
+    const Vec3 origin{12, -4, 3};
+    auto place = [&](double x, double y, double z) { return origin + x * u + y * v + z * axis; };
+    std::vector<Vec3> hole, hole_n, bore, bore_n, ring, ring_n;
+    for (int i = 0; i < 3000; ++i) {
+        const double a = 2 * kPi * rng.uniform();
+        const Vec3 radial = std::cos(a) * u + std::sin(a) * v;
+        auto jitter = [&] {
+            return Vec3{0.002 * rng.gaussian(), 0.002 * rng.gaussian(), 0.002 * rng.gaussian()};
+        };
+        hole.push_back(place(5 * std::cos(a), 5 * std::sin(a), 10 * rng.uniform()) + jitter());
+        hole_n.push_back(-radial);
+        bore.push_back(place(8 * std::cos(a), 8 * std::sin(a), 10 + 4 * rng.uniform()) + jitter());
+        bore_n.push_back(-radial);
+        const double rr = 5 + 3 * rng.uniform();
+        ring.push_back(place(rr * std::cos(a), rr * std::sin(a), 10) + jitter());
+        ring_n.push_back(axis);
+    }
+    const std::vector<FitInput> inputs = {
+        {hole, hole_n, {}}, {bore, bore_n, {}}, {ring, ring_n, {}}};
+    std::vector<FitResult> fits = {fit(FitKind::kCylinder, inputs[0]),
+                                   fit(FitKind::kCylinder, inputs[1]),
+                                   fit(FitKind::kPlane, inputs[2])};
+    for (const FitResult& f : fits) ASSERT_TRUE(f.ok);
+    // Fitted apart, the three axes differ by noise.
+    EXPECT_NE(fits[0].surface.axis, fits[1].surface.axis);
+    const double tol = 0.01;
+    const std::vector<std::string> notes = snap_together(fits, inputs, tol);
+    ASSERT_EQ(notes.size(), 2u);
+    EXPECT_EQ(notes[0], "3 axes made parallel");
+    EXPECT_EQ(notes[1], "2 surfaces made coaxial");
+    const Vec3 d0 = fits[0].surface.axis, d1 = fits[1].surface.axis, n2 = fits[2].surface.axis;
+    EXPECT_EQ(std::fabs(dot(d0, d1)), 1.0);
+    EXPECT_NEAR(std::fabs(dot(d0, n2)), 1.0, 1e-15);
+    EXPECT_LE(line_distance(fits[1].surface.point, fits[0].surface.point, d0), 1e-12);
+    EXPECT_LE(axis_angle_deg(d0, axis, false), 0.01);
+    for (const FitResult& f : fits) EXPECT_LE(f.max, tol);
+    // A tolerance the noise cannot meet: nothing is snapped.
+    std::vector<FitResult> again = {fit(FitKind::kCylinder, inputs[0]),
+                                    fit(FitKind::kCylinder, inputs[1]),
+                                    fit(FitKind::kPlane, inputs[2])};
+    EXPECT_TRUE(snap_together(again, inputs, 0.001).empty());
 }
 
 TEST(FitSnap, ConeAnglesAndTorusRadii) {

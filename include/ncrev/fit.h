@@ -145,4 +145,14 @@ struct SnapOptions {
 FitResult snap(const FitResult& fit, const FitInput& input, const SnapOptions& options,
                std::vector<std::string>* applied = nullptr);
 
+/// Snaps surfaces to each other, as machined features are (method.md Step 4): axes (and plane
+/// normals) within 0.5 degree of each other become one direction, and cylinders, cones and
+/// tori whose axes are then within `tolerance` of each other share one axis line (coaxial
+/// bores, a counterbore and its hole, a turned shaft's steps). A group is snapped only when
+/// every member, refitted with the common axis held, keeps its points within `tolerance`.
+/// `fits[i]` was fitted to `inputs[i]`; fits that are not ok, spheres, B-splines and the
+/// sheared kinds are left alone. Returns what was done, in words.
+std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<const FitInput> inputs,
+                                       double tolerance);
+
 }  // namespace ncrev

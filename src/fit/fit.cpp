@@ -1338,6 +1338,10 @@ namespace {
 
 /// Parameter bits of the models (see their residual()).
 constexpr unsigned kDirBits = (1u << 2) | (1u << 3);
+/// The axis position across the axis (cylinders, cones, tori).
+constexpr unsigned kPositionBits = (1u << 0) | (1u << 1);
+/// Axes closer than this are made parallel when the tolerance allows.
+constexpr double kParallelDegrees = 0.5;
 constexpr double kAxisSnapDegrees = 2.0;
 constexpr double kRadiusSteps[] = {1.0, 0.5, 0.1, 0.05, 0.01};
 constexpr double kAngleStepsDegrees[] = {5.0, 1.0, 0.5};
@@ -1476,6 +1480,100 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
         }
     }
     return cur;
+}
+
+std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<const FitInput> inputs,
+                                       double tolerance) {
+    std::vector<std::string> notes;
+    if (fits.size() != inputs.size()) return notes;
+    auto has_axis = [&](std::size_t i) {
+        const FitKind k = fits[i].surface.kind;
+        return fits[i].ok && (k == FitKind::kPlane || k == FitKind::kCylinder ||
+                              k == FitKind::kCone || k == FitKind::kTorus);
+    };
+    auto is_revolution = [&](std::size_t i) {
+        return has_axis(i) && fits[i].surface.kind != FitKind::kPlane;
+    };
+    // Refits every member with `frozen` held at the surface `make(i)` gives; commits only
+    // when all keep the tolerance.
+    auto try_group = [&](const std::vector<std::size_t>& group, unsigned frozen, const auto& make) {
+        std::vector<FitResult> out;
+        for (const std::size_t i : group) {
+            FitResult r = refit_surface(make(i), frozen, inputs[i]);
+            if (!r.ok || r.max > tolerance) return false;
+            out.push_back(std::move(r));
+        }
+        for (std::size_t k = 0; k < group.size(); ++k) fits[group[k]] = std::move(out[k]);
+        return true;
+    };
+    const double cos_parallel = std::cos(kParallelDegrees * kPi / 180);
+    // 1. Parallel directions: greedy groups around each unassigned axis, in order.
+    std::vector<int> group_of(fits.size(), -1);
+    std::vector<std::vector<std::size_t>> groups;
+    for (std::size_t i = 0; i < fits.size(); ++i) {
+        if (!has_axis(i) || group_of[i] >= 0) continue;
+        std::vector<std::size_t> g{i};
+        for (std::size_t j = i + 1; j < fits.size(); ++j) {
+            if (has_axis(j) && group_of[j] < 0 &&
+                std::fabs(dot(fits[i].surface.axis, fits[j].surface.axis)) >= cos_parallel) {
+                g.push_back(j);
+            }
+        }
+        for (const std::size_t k : g) group_of[k] = static_cast<int>(groups.size());
+        groups.push_back(g);
+    }
+    for (const auto& g : groups) {
+        if (g.size() < 2) continue;
+        // The common direction: the point-count-weighted mean, signs aligned with the first.
+        Vec3 mean{};
+        for (const std::size_t i : g) {
+            const Vec3 a = fits[i].surface.axis;
+            mean += static_cast<double>(inputs[i].points.size()) *
+                    (dot(a, fits[g[0]].surface.axis) < 0 ? -a : a);
+        }
+        const Vec3 dir = normalized(mean);
+        const bool ok = try_group(g, kDirBits, [&](std::size_t i) {
+            Surface s = fits[i].surface;
+            s.axis = dot(s.axis, dir) < 0 ? -dir : dir;
+            return s;
+        });
+        if (ok) notes.push_back(std::to_string(g.size()) + " axes made parallel");
+    }
+    // 2. Coaxial: surfaces of revolution whose axis lines (now parallel) nearly coincide.
+    std::vector<bool> used(fits.size(), false);
+    for (std::size_t i = 0; i < fits.size(); ++i) {
+        if (!is_revolution(i) || used[i]) continue;
+        const Vec3 d = fits[i].surface.axis;
+        std::vector<std::size_t> g{i};
+        for (std::size_t j = i + 1; j < fits.size(); ++j) {
+            if (!is_revolution(j) || used[j]) continue;
+            if (std::fabs(dot(d, fits[j].surface.axis)) < 1 - 1e-12) continue;
+            const Vec3 w = fits[j].surface.point - fits[i].surface.point;
+            if (norm(w - dot(w, d) * d) <= tolerance) g.push_back(j);
+        }
+        if (g.size() < 2) continue;
+        // The common line: through the mean of the members' axis points, projected.
+        Vec3 mean{};
+        double total = 0;
+        for (const std::size_t k : g) {
+            const double wgt = static_cast<double>(inputs[k].points.size());
+            const Vec3 w = fits[k].surface.point - fits[i].surface.point;
+            mean += wgt * (w - dot(w, d) * d);
+            total += wgt;
+        }
+        const Vec3 base = fits[i].surface.point + mean / total;
+        const bool ok = try_group(g, kDirBits | kPositionBits, [&](std::size_t k) {
+            Surface s = fits[k].surface;
+            // Keep the member's own place along the axis.
+            s.point = base + dot(s.point - base, d) * d;
+            return s;
+        });
+        if (ok) {
+            for (const std::size_t k : g) used[k] = true;
+            notes.push_back(std::to_string(g.size()) + " surfaces made coaxial");
+        }
+    }
+    return notes;
 }
 
 }  // namespace ncrev
