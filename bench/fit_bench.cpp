@@ -86,6 +86,7 @@ void BM_Fit(benchmark::State& state) {
     const auto kind = static_cast<FitKind>(state.range(0));
     const Points& pts = patch(kind, static_cast<std::size_t>(state.range(1)));
     int iterations = 0;
+    double radius = 0;
     for (auto _ : state) {
         // The B-spline to a tolerance of about 6 sigma of the noise (fit()'s default, 1e-4 of
         // the extent, is below the noise and would grow the net to its limit).
@@ -94,10 +95,12 @@ void BM_Fit(benchmark::State& state) {
                                 : fit(kind, FitInput{pts.p, pts.n, {}});
         if (!r.ok) state.SkipWithError(r.failure.c_str());
         iterations = r.iterations;
+        radius = r.surface.radius;
         benchmark::DoNotOptimize(r.surface.radius);
     }
     state.SetLabel(to_string(kind));
     state.counters["lm_iterations"] = iterations;  // B-spline: the poles of the net
+    state.counters["radius"] = radius;             // true: cylinder 10, torus R 25
     state.counters["fits/s"] =
         benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
