@@ -29,27 +29,16 @@ Rings two_rings(const Mesh& m) {
     Rings r;
     r.offset.push_back(0);
     std::vector<std::uint32_t> ring;
-    auto neighbours = [&](VertexId v, auto&& f) {
-        const HalfedgeId h0 = m.outgoing(v);
-        HalfedgeId h = h0;
-        do {
-            f(m.target(h).idx());
-            const HalfedgeId t = m.twin(Mesh::prev(h));
-            if (!t.is_valid()) {
-                f(m.origin(Mesh::prev(h)).idx());
-                break;
-            }
-            h = t;
-        } while (h != h0);
-    };
     for (std::size_t v = 0; v < m.num_vertices(); ++v) {
         ring.assign(1, static_cast<std::uint32_t>(v));
         auto add = [&](std::uint32_t w) {
             if (std::find(ring.begin(), ring.end(), w) == ring.end()) ring.push_back(w);
         };
-        neighbours(VertexId(static_cast<std::uint32_t>(v)), add);
+        m.for_each_neighbour(VertexId(static_cast<std::uint32_t>(v)),
+                             [&](VertexId w) { add(w.idx()); });
         const std::size_t first = ring.size();
-        for (std::size_t i = 1; i < first; ++i) neighbours(VertexId(ring[i]), add);
+        for (std::size_t i = 1; i < first; ++i)
+            m.for_each_neighbour(VertexId(ring[i]), [&](VertexId w) { add(w.idx()); });
         r.ids.insert(r.ids.end(), ring.begin(), ring.end());
         r.offset.push_back(static_cast<std::uint32_t>(r.ids.size()));
     }

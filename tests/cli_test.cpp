@@ -206,6 +206,9 @@ TEST(CliCurvature, WritesTheTypedPlyAndOneJsonDocument) {
     const auto j = nlohmann::json::parse(r.out);
     const auto& c = j["curvature"];
     EXPECT_EQ(c["estimator"], "plain");
+    // The CLI runs the library's default neighbourhood.
+    EXPECT_EQ(c["neighbourhood"].get<std::string>().rfind("3 smoothing passes", 0), 0u)
+        << c["neighbourhood"];
     EXPECT_GT(c["thresholds"]["planar_curvedness"].get<double>(), 0.0);
     EXPECT_EQ(c["thresholds"]["sharp_edge_angle"], kDefaultSharpEdgeAngle);
     std::uint64_t total = 0;
@@ -222,6 +225,12 @@ TEST(CliCurvature, WritesTheTypedPlyAndOneJsonDocument) {
         EXPECT_NEAR(x.shape_index, 1.0, 0.05);
         EXPECT_EQ(x.red, 220);  // the color of "cap"
     }
+    const CliRun k = run("curvature " + in.string() + " -o " + out.string() +
+                         " --json -q --neighbourhood kernel");
+    ASSERT_EQ(k.code, 0) << k.err;
+    EXPECT_EQ(nlohmann::json::parse(k.out)["curvature"]["neighbourhood"].get<std::string>().rfind(
+                  "kernel", 0),
+              0u);
     // Without --json: a text summary, and the same PLY.
     const CliRun t = run("curvature " + in.string() + " -o " + out.string() + " -q");
     ASSERT_EQ(t.code, 0) << t.err;

@@ -16,11 +16,7 @@ namespace {
 
 struct CurvatureCliOptions {
     std::string input, output;
-    CurvatureEstimator estimator = CurvatureEstimator::kPlain;
-    Neighbourhood neighbourhood = Neighbourhood::kKernel;
-    int rings = 2;
-    double radius = 0;
-    double planar = -1;
+    CurvatureOptions curvature;  ///< the library's defaults, overridden by the options
     double sharp_degrees = -1;
     bool json = false;
     bool quiet = false;
@@ -42,32 +38,37 @@ void add_curvature(CLI::App& app, Context& ctx) {
     cmd->add_option("-o,--output", o->output, "PLY file to write (atomically)")->required();
     const std::map<std::string, CurvatureEstimator> estimators{
         {"plain", CurvatureEstimator::kPlain}, {"weighted", CurvatureEstimator::kWeighted}};
-    cmd->add_option("--estimator", o->estimator,
+    cmd->add_option("--estimator", o->curvature.estimator,
                     "plain: the normal-cycle shape operator (default); weighted: with the "
                     "paper's per-edge weights (less accurate, see docs/curvature.md)")
         ->transform(CLI::CheckedTransformer(estimators, CLI::ignore_case))
         ->option_text("plain|weighted");
-    const std::map<std::string, Neighbourhood> neighbourhoods{
-        {"kernel", Neighbourhood::kKernel},
-        {"rings", Neighbourhood::kRings},
-        {"geodesic", Neighbourhood::kGeodesic}};
-    cmd->add_option("--neighbourhood", o->neighbourhood,
-                    "kernel: Voronoi cells within about three edges, smoothly weighted, never "
-                    "beyond a small arc of the surface (default); rings: the cells of the "
+    std::map<std::string, Neighbourhood> neighbourhoods;
+    for (const Neighbourhood n : {Neighbourhood::kSmoothed, Neighbourhood::kKernel,
+                                  Neighbourhood::kRings, Neighbourhood::kGeodesic}) {
+        neighbourhoods.emplace(to_string(n), n);
+    }
+    cmd->add_option("--neighbourhood", o->curvature.neighbourhood,
+                    "smoothed (default): three rounds of neighbour averaging under a smooth "
+                    "kernel of about three edges, never beyond a small arc of the surface; "
+                    "kernel: the same kernel summed exactly (slower); rings: the cells of the "
                     "--rings ring; geodesic: the cells within --radius along edges")
         ->transform(CLI::CheckedTransformer(neighbourhoods, CLI::ignore_case))
-        ->option_text("kernel|rings|geodesic");
-    cmd->add_option("--rings", o->rings, "Rings of the 'rings' neighbourhood (default 2)")
+        ->option_text("smoothed|kernel|rings|geodesic");
+    cmd->add_option("--rings", o->curvature.rings, "Rings of the 'rings' neighbourhood")
+        ->capture_default_str()
         ->check(CLI::Range(1, 16));
-    cmd->add_option("--radius", o->radius,
+    cmd->add_option("--radius", o->curvature.radius,
                     "Radius of the 'geodesic' neighbourhood, in the file's unit")
         ->check(CLI::PositiveNumber);
-    cmd->add_option("--planar-curvedness", o->planar,
+    cmd->add_option("--planar-curvedness", o->curvature.planar_curvedness,
                     "Curvedness (1/unit) below which a vertex is planar (default: from the "
                     "model size and the coordinate precision; the value used is reported)")
         ->check(CLI::NonNegativeNumber);
-    cmd->add_option("--sharp-angle", o->sharp_degrees,
-                    "Dihedral angle in degrees from which an edge is sharp (default 34.4)")
+    cmd->add_option(
+           "--sharp-angle", o->sharp_degrees,
+           "Dihedral angle in degrees from which an edge is sharp (default " +
+               std::to_string(kDefaultSharpEdgeAngle * 180 / std::numbers::pi).substr(0, 4) + ")")
         ->check(CLI::Range(0.0, 180.0));
     cmd->add_flag("--json", o->json,
                   "Print one JSON object on stdout: input, healing, mesh, and curvature "
@@ -75,12 +76,13 @@ void add_curvature(CLI::App& app, Context& ctx) {
     cmd->add_flag("-q,--quiet", o->quiet, "No warnings and no progress on stderr");
     cmd->callback([o, cmd, &ctx]() {
         const std::filesystem::path in(o->input), out(o->output);
-        if (o->neighbourhood == Neighbourhood::kGeodesic && o->radius <= 0) {
+        CurvatureOptions co = o->curvature;
+        if (co.neighbourhood == Neighbourhood::kGeodesic && co.radius <= 0) {
             print_error("--neighbourhood geodesic needs --radius");
             ctx.exit_code = kExitUsage;
             return;
         }
-        if (o->neighbourhood != Neighbourhood::kGeodesic && cmd->count("--radius") > 0) {
+        if (co.neighbourhood != Neighbourhood::kGeodesic && cmd->count("--radius") > 0) {
             print_error("--radius applies to --neighbourhood geodesic only");
             ctx.exit_code = kExitUsage;
             return;
@@ -93,12 +95,6 @@ void add_curvature(CLI::App& app, Context& ctx) {
             ctx.exit_code = kExitNoResult;
             return;
         }
-        CurvatureOptions co;
-        co.estimator = o->estimator;
-        co.neighbourhood = o->neighbourhood;
-        co.rings = o->rings;
-        co.radius = o->radius;
-        co.planar_curvedness = o->planar;
         if (o->sharp_degrees >= 0) co.sharp_edge_angle = o->sharp_degrees * std::numbers::pi / 180;
         if (progress) progress("curvature", 0.0);
         const auto t0 = std::chrono::steady_clock::now();

@@ -60,14 +60,13 @@ struct Surface {
     std::shared_ptr<const BSplineSurface> bspline;  ///< kBSpline only
 };
 
-/// A non-rational B-spline surface, clamped, uniform knots on [0, 1] in both directions:
+/// A non-rational B-spline surface, clamped, uniform knots on [0, 1] in both directions (for n
+/// poles: degree + 1 zeros, the n - degree - 1 values i / (n - degree), degree + 1 ones):
 /// poles[i + num_u * j] for i < num_u, j < num_v. Evaluation by de Boor's algorithm.
 struct BSplineSurface {
     int degree = 3;
     int num_u = 0, num_v = 0;
     std::vector<Vec3> poles;
-    /// The knot vector of a direction with n poles (degree + 1 zeros and ones at the ends).
-    std::vector<double> knots(int n) const;
     Vec3 evaluate(double u, double v) const;
     /// Point and first derivatives.
     void evaluate(double u, double v, Vec3& p, Vec3& du, Vec3& dv) const;

@@ -69,6 +69,36 @@ class Mesh {
     HalfedgeId outgoing(VertexId v) const { return HalfedgeId(outgoing_[v.idx()]); }
     VertexId vertex(FaceId f, int i) const { return origin(halfedge(f, i)); }
 
+    /// Calls f(h) for every outgoing half-edge of v, around its whole fan (open or closed).
+    template <class F>
+    void for_each_outgoing(VertexId v, F&& f) const {
+        const HalfedgeId h0 = outgoing(v);
+        if (!h0.is_valid()) return;
+        HalfedgeId h = h0;
+        do {
+            f(h);
+            const HalfedgeId t = twin(prev(h));
+            if (!t.is_valid()) return;
+            h = t;
+        } while (h != h0);
+    }
+    /// Calls f(w) for every neighbour w of v, once each (also the far end of an open fan).
+    template <class F>
+    void for_each_neighbour(VertexId v, F&& f) const {
+        const HalfedgeId h0 = outgoing(v);
+        if (!h0.is_valid()) return;
+        HalfedgeId h = h0;
+        do {
+            f(target(h));
+            const HalfedgeId t = twin(prev(h));
+            if (!t.is_valid()) {
+                f(origin(prev(h)));
+                return;
+            }
+            h = t;
+        } while (h != h0);
+    }
+
     /// Index of the input facet this face came from (for labels in input order).
     std::uint32_t source_face(FaceId f) const { return source_face_[f.idx()]; }
     std::span<const std::uint32_t> source_faces() const { return source_face_; }

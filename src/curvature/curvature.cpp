@@ -196,20 +196,6 @@ void tangent_basis(Vec3 n, Vec3& t1, Vec3& t2) {
     t2 = {b, sign + n.y * n.y * a, -n.y};
 }
 
-/// Calls f(h) for every outgoing half-edge of v (the whole fan, open or closed).
-template <class F>
-void for_each_outgoing(const Mesh& m, VertexId v, F&& f) {
-    const HalfedgeId h0 = m.outgoing(v);
-    if (!h0.is_valid()) return;
-    HalfedgeId h = h0;
-    do {
-        f(h);
-        const HalfedgeId t = m.twin(Mesh::prev(h));
-        if (!t.is_valid()) break;
-        h = t;
-    } while (h != h0);
-}
-
 /// acos to within 2e-8 rad (Abramowitz and Stegun 4.4.46), several times faster than the
 /// library's; the angles it gives only weight the vertex normal.
 double fast_acos(double x) {
@@ -328,7 +314,7 @@ VertexData vertex_pass(const Mesh& m, const FaceData& fd, VertexId v) {
     double edge_sum = 0;
     int edges = 0;
     HalfedgeId last{};
-    for_each_outgoing(m, v, [&](HalfedgeId h) {
+    m.for_each_outgoing(v, [&](HalfedgeId h) {
         last = h;
         normal += fd.corner_angle[h.idx()] * fd.normal[Mesh::face(h)];
         out.area += fd.corner_share[h.idx()];
@@ -380,24 +366,6 @@ struct Scratch {
     }
 };
 
-/// Calls f(w) for every neighbour w of v (once each on a manifold fan).
-template <class F>
-void for_each_neighbour(const Mesh& m, VertexId v, F&& f) {
-    const HalfedgeId h0 = m.outgoing(v);
-    if (!h0.is_valid()) return;
-    HalfedgeId h = h0;
-    do {
-        f(m.target(h));
-        const HalfedgeId p = Mesh::prev(h);
-        const HalfedgeId t = m.twin(p);
-        if (!t.is_valid()) {
-            f(m.origin(p));  // the far end of an open fan
-            return;
-        }
-        h = t;
-    } while (h != h0);
-}
-
 /// The vertices fewer than `rings` edges from p, reached through vertices within `radius` of p
 /// that are not on sharp edges. With `local_cells`, also only vertices whose cell lies within the
 /// radius (no incident edge longer than it): the cell of a vertex on the border of a CAD face
@@ -412,7 +380,7 @@ void ring_neighbourhood(const Mesh& m, const std::vector<VertexData>& data, doub
     for (int level = 1; level < rings; ++level) {
         const std::size_t level_end = s.set.size();
         for (std::size_t i = level_begin; i < level_end && s.set.size() < kMaxNeighbourhood; ++i) {
-            for_each_neighbour(m, VertexId(s.set[i]), [&](VertexId w) {
+            m.for_each_neighbour(VertexId(s.set[i]), [&](VertexId w) {
                 const VertexData& dw = data[w.idx()];
                 if (s.contains(w.idx()) || dw.max_turn >= sharp) return;
                 if (local_cells && dw.max_edge >= radius) return;
@@ -441,7 +409,7 @@ void geodesic_neighbourhood(const Mesh& m, const std::vector<VertexData>& data, 
         if (s.contains(v)) continue;
         s.insert(v);
         const Vec3 pq = m.position(VertexId(v));
-        for_each_neighbour(m, VertexId(v), [&](VertexId w) {
+        m.for_each_neighbour(VertexId(v), [&](VertexId w) {
             if (s.contains(w.idx()) || data[w.idx()].max_turn >= sharp) return;
             const double dw = d + norm(m.position(w) - pq);
             if (dw >= radius) return;
@@ -459,7 +427,7 @@ Sym3 weighted_tensor(const Mesh& m, const FaceMap<Vec3>& face_normal, Vec3 np, c
     for (const std::uint32_t qi : s.set) {
         const VertexId q(qi);
         const Vec3 pq = m.position(q);
-        for_each_outgoing(m, q, [&](HalfedgeId h) {
+        m.for_each_outgoing(q, [&](HalfedgeId h) {
             const HalfedgeId t = m.twin(h);
             if (!t.is_valid()) return;
             const Vec3 u = m.position(m.target(h)) - pq;
@@ -506,7 +474,7 @@ Adjacency adjacency(const Mesh& m) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
         for (std::size_t v = r.begin(); v != r.end(); ++v) {
             std::uint32_t n = 0;
-            for_each_neighbour(m, VertexId(static_cast<std::uint32_t>(v)), [&](VertexId) { ++n; });
+            m.for_each_neighbour(VertexId(static_cast<std::uint32_t>(v)), [&](VertexId) { ++n; });
             a.offset[v + 1] = n;
         }
     });
@@ -515,8 +483,8 @@ Adjacency adjacency(const Mesh& m) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
         for (std::size_t v = r.begin(); v != r.end(); ++v) {
             std::uint32_t* out = a.ids.data() + a.offset[v];
-            for_each_neighbour(m, VertexId(static_cast<std::uint32_t>(v)),
-                               [&](VertexId w) { *out++ = w.idx(); });
+            m.for_each_neighbour(VertexId(static_cast<std::uint32_t>(v)),
+                                 [&](VertexId w) { *out++ = w.idx(); });
         }
     });
     return a;
@@ -529,6 +497,15 @@ struct Planar {
     double mean = 0, diff = 0, off = 0;
 };
 
+/// A 3D tensor restricted to the tangent plane of unit normal n, in the frame of
+/// tangent_basis(n) (the frame the eigen-decomposition uses).
+Planar in_frame(const Sym3& w, Vec3 n) {
+    Vec3 t1, t2;
+    tangent_basis(n, t1, t2);
+    const double a = w.form(t1, t1), b = w.form(t1, t2), c = w.form(t2, t2);
+    return {0.5 * (a + c), 0.5 * (a - c), b};
+}
+
 /// Neighbourhood::kSmoothed: `passes` rounds in which every vertex adds its eligible
 /// neighbours' tensors (carried to its own tangent plane) and areas to its own, weighted by
 /// the kernel (1 - d^2/R^2)^2 of their distance d, R being p's reach. A neighbour is eligible
@@ -539,12 +516,11 @@ struct Planar {
 /// cos 2psi and sin 2psi once makes each round a few multiply-adds per neighbour instead of a
 /// 3x3 rotation.
 void smooth(const Mesh& m, const std::vector<VertexData>& data, const CurvatureOptions& o,
-            double sharp, double kernel_edges, double kernel_angle, std::vector<Sym3>& tensor,
+            double sharp, double kernel_edges, double kernel_angle, std::vector<Planar>& cur,
             std::vector<double>& area) {
     const std::size_t nv = m.num_vertices();
     const Adjacency adj = adjacency(m);
-    std::vector<Planar> cur, next;
-    detail::resize_huge(cur, nv);
+    std::vector<Planar> next;
     detail::resize_huge(next, nv);
     // Per (vertex, neighbour) slot: w cos 2psi, w sin 2psi and the kernel weight w, or NaN
     // when not eligible.
@@ -565,9 +541,7 @@ void smooth(const Mesh& m, const std::vector<VertexData>& data, const CurvatureO
             normal[v] = dv.normal;
             axis[v] = t1;
             extent[v] = dv.max_turn < sharp ? dv.max_edge : kInfinity;
-            const double a = dv.tensor.form(t1, t1), b = dv.tensor.form(t1, t2),
-                         c = dv.tensor.form(t2, t2);
-            cur[v] = {0.5 * (a + c), 0.5 * (a - c), b};
+            cur[v] = in_frame(dv.tensor, dv.normal);
             area[v] = dv.area;
         }
     });
@@ -625,21 +599,6 @@ void smooth(const Mesh& m, const std::vector<VertexData>& data, const CurvatureO
         cur.swap(next);
         area.swap(next_area);
     }
-    // Back to 3D in p's frame, for the common eigen-decomposition.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const auto& r) {
-        for (std::size_t v = r.begin(); v != r.end(); ++v) {
-            Vec3 t1, t2;
-            tangent_basis(data[v].normal, t1, t2);
-            const Planar& t = cur[v];
-            Sym3 w;
-            w.add_outer(t1, t.mean + t.diff);
-            w.add_outer(t2, t.mean - t.diff);
-            // (t1 + t2)(t1 + t2)^T - (t1 - t2)(t1 - t2)^T = 2 (t1 t2^T + t2 t1^T).
-            w.add_outer(t1 + t2, 0.5 * t.off);
-            w.add_outer(t1 - t2, -0.5 * t.off);
-            tensor[v] = w;
-        }
-    });
 }
 
 double median_edge_length(const Mesh& m) {
@@ -770,7 +729,8 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
 
     const double sharp = th.sharp_edge_angle;
     const double planar = th.planar_curvedness;
-    std::vector<Sym3> tensor;
+    // Every vertex's neighbourhood: its tensor in the vertex's tangent frame, and its area.
+    std::vector<Planar> tensor;
     std::vector<double> area;
     detail::resize_huge(tensor, nv);
     detail::resize_huge(area, nv);
@@ -800,7 +760,7 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
                 }
                 if (options.estimator == CurvatureEstimator::kWeighted) {
                     for (const std::uint32_t q : s.set) area[vi] += data[q].area;
-                    tensor[vi] = weighted_tensor(m, face_normal, d.normal, s);
+                    tensor[vi] = in_frame(weighted_tensor(m, face_normal, d.normal, s), d.normal);
                     continue;
                 }
                 const Vec3 pp = m.position(p);
@@ -821,7 +781,7 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
                         w.add(data[q].tensor, kw);
                     }
                 }
-                tensor[vi] = w;
+                tensor[vi] = in_frame(w, d.normal);
                 area[vi] = a;
             }
         });
@@ -833,14 +793,14 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
             const VertexData& d = data[vi];
             const Vec3 n = d.normal;
             out.normal[p] = n;
-            const Sym3& w = tensor[vi];
+            const Planar& w = tensor[vi];
             double k1 = 0, k2 = 0;
             Vec3 t1{}, t2{};
             if (area[vi] > 0 && norm(n) > 0) {
                 tangent_basis(n, t1, t2);
                 const double inv = 1.0 / area[vi];
-                const double a = w.form(t1, t1) * inv, b = w.form(t1, t2) * inv,
-                             c = w.form(t2, t2) * inv;
+                const double a = (w.mean + w.diff) * inv, b = w.off * inv,
+                             c = (w.mean - w.diff) * inv;
                 const double mean = 0.5 * (a + c), half = 0.5 * (a - c);
                 const double radius = std::sqrt(half * half + b * b);
                 const double mu1 = mean + radius, mu2 = mean - radius;

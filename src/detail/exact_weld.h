@@ -9,14 +9,14 @@
 // 2 cores: it scatters the accesses to the points.)
 #pragma once
 
-#include <sys/mman.h>
-
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
+
+#include "detail/huge_pages.h"
 
 namespace ncrev::detail {
 
@@ -97,15 +97,7 @@ class ExactWelder {
     // Probing a large table misses the TLB on almost every new vertex (4 KiB pages cover a
     // 64 MiB table with 16384 entries); on Linux, ask for transparent huge pages first.
     static void allocate_table(std::vector<std::uint64_t>& t, std::size_t n) {
-        t.reserve(n);
-#ifdef MADV_HUGEPAGE
-        constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
-        const auto b = reinterpret_cast<std::uintptr_t>(t.data());
-        const std::uintptr_t lo = (b + kHuge - 1) & ~(kHuge - 1);
-        const std::uintptr_t hi = (b + n * sizeof(std::uint64_t)) & ~(kHuge - 1);
-        if (hi > lo) ::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);
-#endif
-        t.assign(n, 0);
+        resize_huge(t, n);  // zero-filled
     }
 
     void grow() {

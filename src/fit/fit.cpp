@@ -51,16 +51,6 @@ const char* to_string(FitKind kind) {
 // ---------------------------------------------------------------------------------------
 // B-spline surfaces (L. Piegl and W. Tiller, "The NURBS Book", 2nd ed., algorithms A2.1-A2.3).
 
-std::vector<double> BSplineSurface::knots(int n) const {
-    std::vector<double> k;
-    const int p = degree;
-    for (int i = 0; i <= p; ++i) k.push_back(0.0);
-    const int inner = n - p - 1;
-    for (int i = 1; i <= inner; ++i) k.push_back(static_cast<double>(i) / (inner + 1));
-    for (int i = 0; i <= p; ++i) k.push_back(1.0);
-    return k;
-}
-
 namespace {
 
 constexpr int kMaxDegree = 3;
