@@ -122,7 +122,15 @@ struct KindSelection {
     FitResult best;
     std::array<FitResult, kNumFitKinds> tried;  ///< every fit attempted, by kind
 };
-KindSelection fit_simplest(const FitInput& input, double tolerance);
+/// A set of kinds: bit (1 << kind).
+using FitKindSet = std::uint32_t;
+constexpr FitKindSet fit_kind_bit(FitKind kind) { return FitKindSet{1} << static_cast<int>(kind); }
+constexpr FitKindSet kAllFitKinds = (FitKindSet{1} << kNumFitKinds) - 1;
+/// Plane, sphere, cylinder, cone, torus.
+constexpr FitKindSet kRevolutionFitKinds = (FitKindSet{1} << 5) - 1;
+/// `kinds` restricts the kinds tried (the others stay not ok in `tried`).
+KindSelection fit_simplest(const FitInput& input, double tolerance,
+                           FitKindSet kinds = kAllFitKinds);
 
 /// What snap() may do. Every change is kept only when the refitted surface (the snapped values
 /// held, the other parameters fitted again) still keeps every point within `tolerance`.

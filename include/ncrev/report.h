@@ -33,6 +33,8 @@ struct InfoReport {
 struct HealedMesh {
     Mesh mesh;
     InfoReport report;
+    std::vector<ToolRecord> tools;        ///< the SRE tools table (empty for STL)
+    std::vector<SurfaceRecord> surfaces;  ///< the SRE surfaces table (empty for STL)
 };
 
 /// Reads and heals a mesh file (welding exactly while reading), keeping the mesh.

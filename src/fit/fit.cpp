@@ -933,7 +933,7 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
     const double aspect = (x1 - x0) / (y1 - y0);
     int base = kBSplineStartPoles;
     const auto max_poles =
-        static_cast<int>(std::min<std::size_t>(n / 4, kBSplineMaxPoles * kBSplineMaxPoles));
+        static_cast<int>(std::min<std::size_t>(n / 2, kBSplineMaxPoles * kBSplineMaxPoles));
     FitResult best = fail;
     int last_nu = 0, last_nv = 0;  // the net stops growing at kBSplineMaxPoles
     for (;;) {
@@ -1295,7 +1295,7 @@ FitResult fit(FitKind kind, const FitInput& in) {
     return failed(kind, "unknown kind");
 }
 
-KindSelection fit_simplest(const FitInput& input, double tolerance) {
+KindSelection fit_simplest(const FitInput& input, double tolerance, FitKindSet kinds) {
     KindSelection sel;
     // Rounds of kinds: the surfaces of revolution first; the sheared kinds only when none of
     // those fits; the B-spline last. Within a round, the simplest passing kind wins unless a
@@ -1305,6 +1305,7 @@ KindSelection fit_simplest(const FitInput& input, double tolerance) {
         double best_rms = std::numeric_limits<double>::infinity();
         for (int k = round[0]; k < round[1]; ++k) {
             const auto kind = static_cast<FitKind>(k);
+            if ((kinds & fit_kind_bit(kind)) == 0) continue;
             sel.tried[static_cast<std::size_t>(k)] =
                 kind == FitKind::kBSpline ? fit_bspline(input, tolerance) : fit(kind, input);
             const FitResult& r = sel.tried[static_cast<std::size_t>(k)];

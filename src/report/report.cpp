@@ -72,6 +72,8 @@ Result<HealedMesh> read_and_heal(const std::filesystem::path& path, const HealOp
     r.input_points = soup->points.size() + soup->welded_points;
     r.tools = soup->tools.size();
     r.surfaces = soup->surfaces.size();
+    std::vector<ToolRecord> tools = std::move(soup->tools);
+    std::vector<SurfaceRecord> surfaces = std::move(soup->surfaces);
     auto built = build_mesh(std::move(soup).value(), options, progress);
     if (!built) {
         Error e = built.error();
@@ -84,7 +86,7 @@ Result<HealedMesh> read_and_heal(const std::filesystem::path& path, const HealOp
     r.read_seconds = std::chrono::duration<double>(t1 - t0).count();
     r.build_seconds = std::chrono::duration<double>(t2 - t1).count();
     r.warnings = make_warnings(r);
-    return HealedMesh{std::move(built->mesh), std::move(r)};
+    return HealedMesh{std::move(built->mesh), std::move(r), std::move(tools), std::move(surfaces)};
 }
 
 namespace {

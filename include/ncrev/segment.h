@@ -1,0 +1,124 @@
+// segment: the mesh split into regions, one surface each (../shared/docs/method.md, Step 3).
+//
+// Two methods:
+// - facets (the default, it measures better, docs/segmentation.md): sharp edges (dihedral
+//   angle) split the mesh into smooth patches; each patch is grown region by region from its
+//   most interior facets, a region taking a neighbouring facet while one analytic surface keeps
+//   every vertex within the tolerance and agrees with every facet's normal (so a fillet stops
+//   where the plane it is tangent to begins: the type changes, the fit fails); adjacent regions
+//   that one surface fits are merged, most alike first; groups of small curved pieces that one
+//   B-spline fits become one free-form region; border facets go to the neighbouring region they
+//   fit best.
+// - paper: the paper's vertex method: vertex types from `curvature`, high-curvature points set
+//   aside, refining over one-rings, connected components, merging region pairs through a
+//   priority queue while one surface fits the union, then the set-aside points and the facets.
+//
+// With SRE input the given surface indices are used where present (one region per surface
+// index, its surface the given one); only the facets with index -1 are segmented.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "ncrev/common.h"
+#include "ncrev/curvature.h"
+#include "ncrev/fit.h"
+#include "ncrev/io.h"
+#include "ncrev/mesh.h"
+
+namespace ncrev {
+
+enum class SegmentMethod { kFacets, kPaper };
+/// "facets", "paper".
+const char* to_string(SegmentMethod method);
+
+/// Default tolerance as a fraction of the bounding-box diagonal: 0.01 mm on a 100 mm part, a
+/// tenth of a general machining tolerance. The vertices of a CAD or simulator tessellation lie
+/// on the surface they sample (to float rounding); vertices further than this from a region's
+/// surface belong to another surface.
+constexpr double kSegmentRelativeTolerance = 2e-4;
+/// Default sharp-edge angle (rad, 30 degrees): above the normal step inside curved faces of
+/// usual tessellations (20 degrees and less), below a 45-degree chamfer or countersink. It only
+/// cuts the mesh into patches to grow in: fitting decides, so a missed sharp edge is still a
+/// border and a false one is merged over.
+constexpr double kDefaultSegmentSharpAngle = 0.5235987755982988;
+/// Largest angle (rad, 15 degrees) between a facet's normal and its region surface's normal at
+/// the facet: chords of a curved face differ from it by about a sixth of the normal step
+/// between neighbouring facets (7.5 degrees for 45-degree steps), while a surface fitted through
+/// the corners of two faces that meet at a crease (a slot's walls and floor lie on one
+/// cylinder) misses their normals by far more.
+constexpr double kSegmentNormalAngle = 0.2617993877991494;
+
+/// Options of segment(). The defaults need no tuning.
+struct SegmentOptions {
+    SegmentMethod method = SegmentMethod::kFacets;
+    /// Max distance of a region's vertices to its surface, model units; <= 0: derived (see
+    /// SegmentResult::tolerance_rule).
+    double tolerance = 0;
+    /// Dihedral angle (rad) from which an edge is sharp; <= 0: kDefaultSegmentSharpAngle.
+    double sharp_angle = 0;
+    /// The SRE surfaces table (HealedMesh::surfaces): with it, faces whose surface index names
+    /// a surface keep that surface as their region (when `use_surface_indices`).
+    std::span<const SurfaceRecord> surfaces;
+    bool use_surface_indices = true;
+    /// Curvature for the paper method (its vertex types and high-curvature points).
+    CurvatureOptions curvature;
+};
+
+/// One region: the facets that one surface describes.
+struct Region {
+    std::int32_t id = 0;  ///< the label of its facets
+    /// Its surface and the residuals of its vertices (points of the facets, weighted by area).
+    /// `fit.ok` is false only when no surface fits the region at all (paper method).
+    FitResult fit;
+    /// Every vertex within the tolerance of the surface.
+    bool within_tolerance = false;
+    /// The SRE surface index it came from; -1 when segmented.
+    std::int32_t surface_index = -1;
+    std::uint64_t facets = 0;
+    double area = 0;
+};
+
+struct SegmentResult {
+    SegmentMethod method = SegmentMethod::kFacets;
+    double tolerance = 0;
+    std::string tolerance_rule;
+    double sharp_angle = 0;
+    /// The mesh's chordal deflection as estimated from its curved edges: a facet belongs to a
+    /// surface only if its middle is within this of it.
+    double chordal_deflection = 0;
+    /// The region of every face (ids index `regions`).
+    FaceMap<std::int32_t> region;
+    /// Regions in the order of their first face.
+    std::vector<Region> regions;
+    std::uint64_t given_facets = 0;       ///< facets whose region came from an SRE surface index
+    std::uint64_t patches = 0;            ///< smooth patches (facets) or initial regions (paper)
+    std::uint64_t merges = 0;             ///< region pairs merged
+    std::uint64_t freeform_groups = 0;    ///< groups of pieces replaced by one B-spline
+    std::uint64_t reassigned_facets = 0;  ///< border facets moved to a better-fitting region
+    double curvature_seconds = 0, segment_seconds = 0, fit_seconds = 0;
+};
+
+/// Segments `mesh`. Never throws; deterministic whatever the thread count. Fails (kBadValue)
+/// only for a non-finite tolerance or angle.
+Result<SegmentResult> segment(const Mesh& mesh, const SegmentOptions& options = {},
+                              const ProgressFn& progress = {});
+
+/// The default tolerance of segment() for `mesh`, and its rule in words.
+double default_segment_tolerance(const Mesh& mesh, std::string* rule = nullptr);
+
+/// The analytic surface an SRE record states (directions normalised, lengths as given).
+Surface surface_from_record(const SurfaceRecord& record);
+
+/// One label per input facet, in input order: the region of the face it became, -1 for a facet
+/// that healing removed. `input_facets` is the number of facets the file had.
+std::vector<std::int32_t> input_labels(const Mesh& mesh, const SegmentResult& result,
+                                       std::size_t input_facets);
+
+/// A binary PLY of the mesh whose faces carry `region` (int) and `red green blue` (uchar), one
+/// color per region.
+std::vector<std::byte> encode_segments_ply(const Mesh& mesh, const SegmentResult& result);
+
+}  // namespace ncrev

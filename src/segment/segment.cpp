@@ -1,0 +1,1240 @@
+// segment: see include/ncrev/segment.h. The facets method is in this file's first half, the
+// paper's vertex method after it; both end in the same merging, refining and final fitting.
+#include "ncrev/segment.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <queue>
+#include <tuple>
+
+namespace ncrev {
+
+const char* to_string(SegmentMethod method) {
+    switch (method) {
+        case SegmentMethod::kFacets:
+            return "facets";
+        case SegmentMethod::kPaper:
+            return "paper";
+    }
+    return "?";
+}
+
+namespace {
+
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// A group of curved pieces is tried as one free-form region from this many pieces on: fewer
+/// are a real chain of analytic faces far more often than a free-form face.
+constexpr std::size_t kFreeformMinPieces = 3;
+/// The largest B-spline net (16 x 16 cubic) that may replace a group of pieces: a free-form
+/// face needs few poles, while a chain of analytic faces with curvature jumps needs many.
+constexpr int kFreeformMaxPoles = 256;
+/// Vertices a region needs before a kind is fitted to it: one more than the kind's parameters
+/// (plane 3, sphere 4, cylinder 5, cone 6, torus 7), except the plane of a single facet. With
+/// no spare point any point set fits: the corners of a rectangle and a strip of its neighbour
+/// lie on a sphere.
+constexpr std::size_t kMinVertices[5] = {3, 5, 6, 7, 8};
+/// The order kinds are tried in: plane, cylinder, cone, sphere, torus. A band one facet row
+/// wide has its vertices on two circles, which a cone, a sphere and (equal radii) a cylinder
+/// all pass through; machined parts have far more bores and chamfers than spherical zones, and
+/// a spherical face of any size gets more than one row.
+constexpr FitKind kKindOrder[5] = {FitKind::kPlane, FitKind::kCylinder, FitKind::kCone,
+                                   FitKind::kSphere, FitKind::kTorus};
+/// The chordal deflection estimate: kSagFactor x the kSagQuantile quantile of the sags of the
+/// curved edges (a tessellation's sags spread up to its deflection).
+constexpr double kSagQuantile = 0.9;
+constexpr double kSagFactor = 2;
+/// Dihedral angle (rad) below which an edge is flat for the sag estimate: far above float32
+/// rounding of the normals of facets a thousandth of the part wide.
+constexpr double kFlatDihedral = 1e-3;
+/// As fit_simplest(): a richer kind replaces a simpler passing one only when its RMS is lower
+/// by more than 10 % plus 2 % of the tolerance.
+constexpr double kSignificantRms = 1.1;
+constexpr double kRmsFloor = 0.02;
+/// The share of a region's area whose facet normals may disagree with its surface.
+constexpr double kNormalOutlierArea = 0.02;
+/// A plane with at least this share of the area of the regions smoothly joined to it is a face,
+/// not a piece of a free-form face.
+constexpr double kFreeformPlaneShare = 0.1;
+/// A region this many times larger than the one it merges with keeps its kind.
+constexpr std::size_t kDominantRatio = 4;
+/// See firm_plane().
+constexpr std::size_t kFirmPlaneFacets = 8;
+constexpr double kFirmPlaneShare = 0.25;
+/// Regions of at most this many facets are dissolved into their neighbours when these fit them.
+constexpr std::size_t kSmallRegion = 8;
+/// Rounds of border refinement (each moves facets one row at most).
+constexpr int kRefineRounds = 3;
+/// A border facet moves only when it fits the other region better by this part of the
+/// tolerance (no flip-flopping of facets that fit both, such as those on a tangent line).
+constexpr double kMoveMargin = 0.1;
+/// The paper method's refining rounds (method.md 3.5: "a bounded number of rounds").
+constexpr int kPaperRefineRounds = 10;
+/// The derived tolerance stays this many coordinate rounding units above the coordinates'
+/// own precision (float32 files: rounding alone moves vertices off their surface).
+constexpr double kPrecisionFactor = 16;
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+FaceId fid(std::uint32_t f) { return FaceId(f); }
+
+/// Per-face unit normal, area and centroid.
+struct FaceData {
+    std::vector<Vec3> normal, centroid;
+    std::vector<double> area;
+    std::vector<std::array<std::uint32_t, 3>> adj;  ///< face across each edge, kNone on a border
+};
+
+FaceData face_data(const Mesh& m) {
+    const std::size_t nf = m.num_faces();
+    FaceData d;
+    d.normal.resize(nf);
+    d.centroid.resize(nf);
+    d.area.resize(nf);
+    d.adj.resize(nf);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096), [&](const auto& r) {
+        for (std::size_t f = r.begin(); f != r.end(); ++f) {
+            const FaceId ff = fid(static_cast<std::uint32_t>(f));
+            const Vec3 n2 = m.face_normal_area2(ff);
+            const double l = norm(n2);
+            d.normal[f] = l > 0 ? n2 / l : Vec3{0, 0, 0};
+            d.area[f] = 0.5 * l;
+            d.centroid[f] = (m.position(m.vertex(ff, 0)) + m.position(m.vertex(ff, 1)) +
+                             m.position(m.vertex(ff, 2))) /
+                            3.0;
+            for (int i = 0; i < 3; ++i) {
+                const HalfedgeId t = m.twin(Mesh::halfedge(ff, i));
+                d.adj[f][static_cast<std::size_t>(i)] = t.is_valid() ? Mesh::face(t).idx() : kNone;
+            }
+        }
+    });
+    return d;
+}
+
+/// The points of a set of faces, for fitting: each vertex once, with the area-weighted normal
+/// of the set's facets around it (so a vertex on a border gets its normal from this side) and a
+/// third of their area as its weight.
+struct PointSet {
+    std::vector<Vec3> points, normals;
+    std::vector<double> weights;
+    FitInput input() const { return {points, normals, weights}; }
+};
+
+class Gatherer {
+   public:
+    explicit Gatherer(std::size_t num_vertices) : slot_(num_vertices, kNone) {}
+    void gather(const Mesh& m, const FaceData& fd, std::span<const std::uint32_t> faces,
+                PointSet& out) {
+        out.points.clear();
+        out.normals.clear();
+        out.weights.clear();
+        for (const std::uint32_t f : faces) {
+            for (int i = 0; i < 3; ++i) {
+                const std::uint32_t v = m.vertex(fid(f), i).idx();
+                if (slot_[v] == kNone) {
+                    slot_[v] = static_cast<std::uint32_t>(out.points.size());
+                    touched_.push_back(v);
+                    out.points.push_back(m.position(VertexId(v)));
+                    out.normals.push_back({0, 0, 0});
+                    out.weights.push_back(0);
+                }
+                const std::uint32_t k = slot_[v];
+                out.normals[k] += fd.normal[f] * fd.area[f];
+                out.weights[k] += fd.area[f] / 3;
+            }
+        }
+        for (std::size_t k = 0; k < out.normals.size(); ++k) {
+            const double l = norm(out.normals[k]);
+            if (l > 0) out.normals[k] = out.normals[k] / l;
+        }
+        for (const std::uint32_t v : touched_) slot_[v] = kNone;
+        touched_.clear();
+    }
+
+   private:
+    std::vector<std::uint32_t> slot_;
+    std::vector<std::uint32_t> touched_;
+};
+
+/// Everything the stages share.
+struct Context {
+    const Mesh& m;
+    FaceData fd;
+    double tol = 0;
+    double cos_normal = 0;
+    double sharp = 0;
+    double sag = 0;  ///< the mesh's chordal deflection, estimated (estimate_sag())
+    std::vector<std::uint8_t> sharp_edge;  ///< per half-edge
+    std::vector<float> edge_turn;          ///< |dihedral angle| per half-edge (0 on a border)
+    tbb::enumerable_thread_specific<Gatherer> gatherers;
+    explicit Context(const Mesh& mesh)
+        : m(mesh), gatherers([&mesh] { return Gatherer(mesh.num_vertices()); }) {}
+};
+
+/// The mesh's chordal deflection, from its smooth curved edges: where the normal turns by beta
+/// across an edge between facets of heights h1, h2 over it, chords of width h = min(h1, h2)
+/// sag by about 2 h beta / 8 (a circle's chords of step beta and length h sag h beta / 8). The
+/// smaller height: a plane's large facet next to a tangent fillet is no chord of the fillet.
+/// kSagFactor x the kSagQuantile quantile, never below the tolerance.
+double estimate_sag(const Context& c) {
+    const Mesh& m = c.m;
+    std::vector<double> sags;
+    for (std::uint32_t h = 0; h < m.num_halfedges(); ++h) {
+        const HalfedgeId he(h);
+        const HalfedgeId t = m.twin(he);
+        if (!t.is_valid() || t.idx() < h || c.sharp_edge[h]) continue;
+        const double beta = std::abs(dihedral_angle(m, he));
+        if (beta < kFlatDihedral) continue;  // a plane's edges say nothing of the sag
+        const Vec3 a = m.position(m.origin(he)), b = m.position(m.target(he));
+        const double len = norm(b - a);
+        if (!(len > 0)) continue;
+        const double h1 = 2 * c.fd.area[Mesh::face(he).idx()] / len;
+        const double h2 = 2 * c.fd.area[Mesh::face(t).idx()] / len;
+        sags.push_back(2 * std::min(h1, h2) * beta / 8);
+    }
+    if (sags.empty()) return c.tol;
+    auto q =
+        sags.begin() + static_cast<std::ptrdiff_t>(kSagQuantile * static_cast<double>(sags.size()));
+    std::nth_element(sags.begin(), q, sags.end());
+    return std::max(c.tol, kSagFactor * *q);
+}
+
+/// The surface's unit normal near `p` (a facet centroid), found from the closest points of two
+/// probes on either side along the facet normal `hint`: works for every kind, the B-spline too.
+Vec3 surface_normal(const Surface& s, Vec3 p, Vec3 hint, double h) {
+    if (s.kind == FitKind::kPlane) return s.axis;
+    Vec3 best = hint;
+    double best_len = 0;
+    for (const double sign : {1.0, -1.0}) {
+        const Vec3 q = p + hint * (sign * h);
+        const Vec3 d = q - closest_point(s, q);
+        const double l = norm(d);
+        if (l > best_len) best_len = l, best = d / l;
+    }
+    return best;
+}
+
+/// The facet's normal is the surface's at its middle within kSegmentNormalAngle, or within the
+/// turn of the surface's normal across the facet (its corners' normals) when that is larger: a
+/// chord's normal is one of the normals it spans, and the large fan triangles of a coarse torus
+/// span 40 degrees.
+bool normal_agrees(const Context& c, const Surface& s, std::uint32_t f) {
+    const Vec3 n = c.fd.normal[f];
+    const double h = 4 * c.tol;
+    const Vec3 sn = surface_normal(s, c.fd.centroid[f], n, h);
+    const double cos_mid = std::abs(dot(sn, n));
+    if (cos_mid >= c.cos_normal) return true;
+    if (s.kind == FitKind::kPlane) return false;
+    double cos_span = 1;
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 p = c.m.position(c.m.vertex(fid(f), i));
+        cos_span = std::min(cos_span, std::abs(dot(surface_normal(s, p, n, h), sn)));
+    }
+    return cos_mid >= cos_span;
+}
+
+/// How badly facet f fits s: the largest distance of its corners; infinite when its normal
+/// disagrees with the surface's or its middle is further from the surface than the mesh's
+/// chordal deflection (a chord of the surface: corners on it, middle within the sag).
+double facet_cost(const Context& c, const Surface& s, std::uint32_t f) {
+    double worst = 0;
+    for (int i = 0; i < 3; ++i)
+        worst = std::max(worst, distance(s, c.m.position(c.m.vertex(fid(f), i))));
+    if (worst > c.tol) return worst;
+    if (distance(s, c.fd.centroid[f]) > c.sag) return kInf;
+    return normal_agrees(c, s, f) ? worst : kInf;
+}
+
+bool facet_fits(const Context& c, const Surface& s, std::uint32_t f) {
+    return facet_cost(c, s, f) <= c.tol;
+}
+
+/// The facets are chords of s: every middle within the sag, and the normals close to s's,
+/// except on at most kNormalOutlierArea of the area (slivers: a thin triangle whose corners lie
+/// on one circle of a torus has that circle's plane, whatever the torus's normal there).
+bool chords_agree(const Context& c, const Surface& s, std::span<const std::uint32_t> faces) {
+    // A B-spline is itself held only to the sag at the vertices: its chords' middles get twice.
+    const double limit = s.kind == FitKind::kBSpline ? 2 * c.sag : c.sag;
+    double total = 0, outliers = 0;
+    for (const std::uint32_t f : faces) {
+        if (distance(s, c.fd.centroid[f]) > limit) return false;
+        total += c.fd.area[f];
+        if (!normal_agrees(c, s, f)) outliers += c.fd.area[f];
+    }
+    return outliers <= kNormalOutlierArea * total;
+}
+
+/// The first kind in kKindOrder (of `kinds`) whose fit keeps every vertex of `faces` within
+/// the tolerance and whose chords the facets are (chords_agree()).
+std::optional<FitResult> fit_faces(Context& c, std::span<const std::uint32_t> faces,
+                                   FitKindSet kinds = kRevolutionFitKinds) {
+    PointSet ps;
+    c.gatherers.local().gather(c.m, c.fd, faces, ps);
+    for (const FitKind kind : kKindOrder) {
+        if ((kinds & fit_kind_bit(kind)) == 0) continue;
+        if (ps.points.size() < kMinVertices[static_cast<int>(kind)]) continue;
+        FitResult r = fit(kind, ps.input());
+        if (!r.ok || r.max > c.tol) continue;
+        if (chords_agree(c, r.surface, faces)) return r;
+    }
+    return std::nullopt;
+}
+
+/// A region while segmenting: its faces and the surface they fit.
+struct Draft {
+    std::vector<std::uint32_t> faces;
+    Surface surface;
+    bool alive = true;
+    std::int32_t surface_index = -1;  ///< given by SRE: never merged, never refined
+};
+
+// ---------------------------------------------------------------------------------------------
+// Facets method: patches, growing.
+
+/// Smooth patches: components of the faces in `mask` joined across edges that are not sharp.
+std::vector<std::vector<std::uint32_t>> smooth_patches(const Context& c,
+                                                       const std::vector<std::uint8_t>& mask) {
+    const std::size_t nf = c.m.num_faces();
+    std::vector<std::uint32_t> parent(nf);
+    std::iota(parent.begin(), parent.end(), 0u);
+    const auto find = [&](std::uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        if (!mask[f]) continue;
+        for (int i = 0; i < 3; ++i) {
+            const std::uint32_t g = c.fd.adj[f][static_cast<std::size_t>(i)];
+            if (g == kNone || g < f || !mask[g] ||
+                c.sharp_edge[3 * f + static_cast<std::uint32_t>(i)])
+                continue;
+            const std::uint32_t a = find(f), b = find(g);
+            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        }
+    }
+    std::vector<std::uint32_t> index(nf, kNone);
+    std::vector<std::vector<std::uint32_t>> patches;
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        if (!mask[f]) continue;
+        const std::uint32_t r = find(f);
+        if (index[r] == kNone) {
+            index[r] = static_cast<std::uint32_t>(patches.size());
+            patches.emplace_back();
+        }
+        patches[index[r]].push_back(f);
+    }
+    return patches;
+}
+
+/// A region that is surely a plane: at least kFirmPlaneFacets facets, every vertex within a
+/// kFirmPlaneShare of the tolerance of its plane.
+bool firm_plane(const Context& c, const Draft& d) {
+    if (d.surface.kind != FitKind::kPlane || d.faces.size() < kFirmPlaneFacets) return false;
+    for (const std::uint32_t f : d.faces)
+        for (int i = 0; i < 3; ++i)
+            if (distance(d.surface, c.m.position(c.m.vertex(fid(f), i))) > kFirmPlaneShare * c.tol)
+                return false;
+    return true;
+}
+
+/// Grows the regions of one patch (see the header). `owner` and `mark` are per-face arrays
+/// shared by all patches (patches are disjoint, so threads never touch the same entry).
+std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patch,
+                              const std::vector<std::uint32_t>& patch_of,
+                              std::vector<std::uint32_t>& owner, std::vector<std::uint32_t>& queued,
+                              std::vector<std::uint32_t>& depth, std::uint32_t patch_id) {
+    // Only this patch's entries of owner, queued and depth are read or written here.
+    const auto in_patch = [&](std::uint32_t g) { return g != kNone && patch_of[g] == patch_id; };
+    // Depth: edges from the patch's border, by breadth-first search; seeds deepest first.
+    std::vector<std::uint32_t> queue;
+    queue.reserve(patch.size());
+    for (const std::uint32_t f : patch) {
+        for (const std::uint32_t g : c.fd.adj[f]) {
+            if (!in_patch(g)) {
+                depth[f] = 0;
+                queue.push_back(f);
+                break;
+            }
+        }
+    }
+    if (queue.empty()) {  // a closed smooth surface: start anywhere
+        depth[patch.front()] = 0;
+        queue.push_back(patch.front());
+    }
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+        const std::uint32_t f = queue[head];
+        for (const std::uint32_t g : c.fd.adj[f]) {
+            if (in_patch(g) && depth[g] == kNone) depth[g] = depth[f] + 1, queue.push_back(g);
+        }
+    }
+    // Seeds: facets with fewer edges that turn (curved or sharp) first (inside planes, then inside
+    // curved faces), deepest first among those: a seed on a face's border would take the first kind
+    // that fits a few facets of two faces.
+    const auto curved_edges = [&](std::uint32_t f) {
+        int n = 0;
+        for (int i = 0; i < 3; ++i)
+            n += c.edge_turn[3 * f + static_cast<std::uint32_t>(i)] >= kFlatDihedral;
+        return n;
+    };
+    std::vector<std::uint32_t> seeds = patch;
+    std::stable_sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
+        const int ca = curved_edges(a), cb = curved_edges(b);
+        return ca != cb ? ca < cb : depth[a] > depth[b];
+    });
+
+    std::vector<Draft> drafts;
+    std::vector<std::uint32_t> rejected;
+    for (const std::uint32_t seed : seeds) {
+        if (owner[seed] != kNone) continue;
+        const std::uint32_t rid = static_cast<std::uint32_t>(drafts.size());
+        Draft d;
+        d.surface.kind = FitKind::kPlane;
+        d.surface.point = c.fd.centroid[seed];
+        d.surface.axis = c.fd.normal[seed];
+        owner[seed] = rid;
+        d.faces.push_back(seed);
+        queue.clear();
+        rejected.clear();
+        const auto push_neighbours = [&](std::uint32_t f) {
+            for (const std::uint32_t g : c.fd.adj[f]) {
+                if (!in_patch(g) || owner[g] != kNone || queued[g] == rid) continue;
+                queued[g] = rid;
+                queue.push_back(g);
+            }
+        };
+        push_neighbours(seed);
+        std::size_t last_fit = 1;
+        std::size_t head = 0;
+        for (;;) {
+            while (head < queue.size()) {
+                const std::uint32_t f = queue[head++];
+                if (owner[f] != kNone) continue;
+                if (!facet_fits(c, d.surface, f)) {
+                    rejected.push_back(f);
+                    continue;
+                }
+                owner[f] = rid;
+                d.faces.push_back(f);
+                push_neighbours(f);
+                if (d.faces.size() >= 2 * last_fit && d.faces.size() >= 16) {
+                    // Refit as the region doubles: noise averages out, the kind may change.
+                    if (auto r = fit_faces(c, d.faces)) d.surface = r->surface;
+                    last_fit = d.faces.size();
+                }
+            }
+            // Stalled: does one surface take the whole next ring too (or the next two: a few
+            // facets have too few vertices for the richer kinds)?
+            std::erase_if(rejected, [&](std::uint32_t f) { return owner[f] != kNone; });
+            if (rejected.empty()) break;
+            std::vector<std::uint32_t> trial = d.faces;
+            trial.insert(trial.end(), rejected.begin(), rejected.end());
+            // A region much larger than the ring keeps its kind (as in merge_regions()); so
+            // does a plane of some size that holds its facets well within the tolerance: a
+            // flat torus would take in the plane and half the fillet beside it.
+            const FitKindSet kinds =
+                d.faces.size() >= kDominantRatio * rejected.size() || firm_plane(c, d)
+                    ? fit_kind_bit(d.surface.kind)
+                    : kRevolutionFitKinds;
+            auto r = fit_faces(c, trial, kinds);
+            if (!r) {
+                // The second ring: unassigned neighbours of the first, not yet queued.
+                const std::size_t first = trial.size();
+                for (std::size_t i = d.faces.size(); i < first; ++i) {
+                    for (const std::uint32_t g : c.fd.adj[trial[i]]) {
+                        if (!in_patch(g) || owner[g] != kNone || queued[g] == rid) continue;
+                        queued[g] = rid;
+                        trial.push_back(g);
+                    }
+                }
+                if (trial.size() > first) r = fit_faces(c, trial, kinds);
+                if (r) {
+                    rejected.assign(trial.begin() + static_cast<std::ptrdiff_t>(d.faces.size()),
+                                    trial.end());
+                }
+            }
+            if (!r) break;
+            d.surface = r->surface;
+            for (const std::uint32_t f : rejected) {
+                owner[f] = rid;
+                d.faces.push_back(f);
+                push_neighbours(f);
+            }
+            rejected.clear();
+            last_fit = d.faces.size();
+        }
+        drafts.push_back(std::move(d));
+    }
+    return drafts;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shared stages: merging, free-form groups, refining, final fits.
+
+/// Region adjacency: pairs (a, b), a < b, sharing at least one edge; `smooth_only` keeps
+/// pairs that share a non-sharp edge.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> adjacent_pairs(
+    const Context& c, const std::vector<std::uint32_t>& region, bool smooth_only) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    const std::size_t nf = c.m.num_faces();
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        for (int i = 0; i < 3; ++i) {
+            const std::uint32_t g = c.fd.adj[f][static_cast<std::size_t>(i)];
+            if (g == kNone || g < f) continue;
+            if (smooth_only && c.sharp_edge[3 * f + static_cast<std::uint32_t>(i)]) continue;
+            const std::uint32_t a = region[f], b = region[g];
+            if (a == b || a == kNone || b == kNone) continue;
+            pairs.emplace_back(std::min(a, b), std::max(a, b));
+        }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    return pairs;
+}
+
+std::vector<std::uint32_t> region_of_faces(const Mesh& m, const std::vector<Draft>& drafts) {
+    std::vector<std::uint32_t> region(m.num_faces(), kNone);
+    for (std::uint32_t r = 0; r < drafts.size(); ++r) {
+        if (!drafts[r].alive) continue;
+        for (const std::uint32_t f : drafts[r].faces) region[f] = r;
+    }
+    return region;
+}
+
+/// How alike two regions are (smaller: more alike): the largest distance of one's vertices to
+/// the other's surface, the smaller of the two ways.
+double unlikeness(const Context& c, const Draft& a, const Draft& b) {
+    const auto worst = [&](const Draft& from, const Surface& to) {
+        double w = 0;
+        for (const std::uint32_t f : from.faces)
+            for (int i = 0; i < 3; ++i)
+                w = std::max(w, distance(to, c.m.position(c.m.vertex(fid(f), i))));
+        return w;
+    };
+    return std::min(worst(a, b.surface), worst(b, a.surface));
+}
+
+/// Merges adjacent regions that one analytic surface fits, most alike pair first (method.md
+/// 3.6); the merged region keeps the larger one's index. Returns the number of merges.
+std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
+    std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    // Across sharp edges too (a coarse fillet's facets meet at more than the sharp angle): a
+    // surface through the corners of two faces meeting at a crease (a prism's sides lie on
+    // their circumscribed cylinder) is refused by the sag of their facets.
+    const auto pairs = adjacent_pairs(c, region, false);
+    std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
+    for (const auto& [a, b] : pairs) nbrs[a].push_back(b), nbrs[b].push_back(a);
+    std::vector<std::uint32_t> version(drafts.size(), 0);
+    using Item = std::tuple<double, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> pq;
+    const auto mergeable = [&](std::uint32_t a) {
+        return drafts[a].alive && drafts[a].surface_index < 0 &&
+               drafts[a].surface.kind != FitKind::kBSpline;
+    };
+    const auto push = [&](std::uint32_t a, std::uint32_t b) {
+        if (a > b) std::swap(a, b);
+        if (!mergeable(a) || !mergeable(b)) return;
+        pq.emplace(unlikeness(c, drafts[a], drafts[b]), a, b, version[a], version[b]);
+    };
+    for (const auto& [a, b] : pairs) push(a, b);
+    std::uint64_t merges = 0;
+    while (!pq.empty()) {
+        const auto [cost, a, b, va, vb] = pq.top();
+        pq.pop();
+        if (!drafts[a].alive || !drafts[b].alive || version[a] != va || version[b] != vb) continue;
+        std::vector<std::uint32_t> faces = drafts[a].faces;
+        faces.insert(faces.end(), drafts[b].faces.begin(), drafts[b].faces.end());
+        // A much larger region keeps its kind, and so does a firm plane: a plane does not
+        // become a torus of large radius to take in the fillet beside it, which the tolerance
+        // allows.
+        const std::size_t na = drafts[a].faces.size(), nb = drafts[b].faces.size();
+        FitKindSet kinds = kRevolutionFitKinds;
+        if (na >= kDominantRatio * nb || firm_plane(c, drafts[a]))
+            kinds = fit_kind_bit(drafts[a].surface.kind);
+        if (nb >= kDominantRatio * na || firm_plane(c, drafts[b]))
+            kinds &= fit_kind_bit(drafts[b].surface.kind);
+        auto r = fit_faces(c, faces, kinds);
+        if (!r) continue;
+        const bool keep_a = drafts[a].faces.size() >= drafts[b].faces.size();
+        const std::uint32_t keep = keep_a ? a : b, gone = keep_a ? b : a;
+        std::sort(faces.begin(), faces.end());
+        drafts[keep].faces = std::move(faces);
+        drafts[keep].surface = r->surface;
+        drafts[gone].alive = false;
+        drafts[gone].faces.clear();
+        ++version[keep];
+        ++merges;
+        std::vector<std::uint32_t> n = nbrs[keep];
+        n.insert(n.end(), nbrs[gone].begin(), nbrs[gone].end());
+        std::sort(n.begin(), n.end());
+        n.erase(std::unique(n.begin(), n.end()), n.end());
+        std::erase_if(n,
+                      [&](std::uint32_t x) { return x == keep || x == gone || !drafts[x].alive; });
+        nbrs[keep] = n;
+        for (const std::uint32_t x : n) {
+            std::replace(nbrs[x].begin(), nbrs[x].end(), gone, keep);
+            std::sort(nbrs[x].begin(), nbrs[x].end());
+            nbrs[x].erase(std::unique(nbrs[x].begin(), nbrs[x].end()), nbrs[x].end());
+            push(keep, x);
+        }
+    }
+    return merges;
+}
+
+/// Groups of at least kFreeformMinPieces curved (non-plane) regions joined by smooth edges
+/// that one B-spline of at most kFreeformMaxPoles fits become one free-form region. The
+/// B-spline is held to the mesh's chordal deflection, not the tolerance: a free-form face is
+/// known only as well as its tessellation samples it, and a net small enough to be a face
+/// (not a copy of the mesh) cannot pass through every vertex of it.
+std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
+    const std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    const auto pairs = adjacent_pairs(c, region, true);
+    const auto open = [&](std::uint32_t r) {
+        return drafts[r].alive && drafts[r].surface_index < 0 &&
+               drafts[r].surface.kind != FitKind::kBSpline;
+    };
+    std::vector<std::uint32_t> parent(drafts.size());
+    const auto find = [&](std::uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    const auto components = [&](const auto& member) {
+        std::iota(parent.begin(), parent.end(), 0u);
+        for (const auto& [a, b] : pairs) {
+            if (!member(a) || !member(b)) continue;
+            const std::uint32_t ra = find(a), rb = find(b);
+            if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+        }
+    };
+    // The smoothly joined regions' areas; in them, a plane of at least kFreeformPlaneShare of
+    // the area is a face of its own (a floor next to a tangent free-form wall), smaller ones
+    // are pieces (a free-form face is flat within the tolerance here and there).
+    const auto area = [&](std::uint32_t r) {
+        double a = 0;
+        for (const std::uint32_t f : drafts[r].faces) a += c.fd.area[f];
+        return a;
+    };
+    components(open);
+    std::vector<double> comp_area(drafts.size(), 0);
+    for (std::uint32_t r = 0; r < drafts.size(); ++r)
+        if (open(r)) comp_area[find(r)] += area(r);
+    std::vector<std::uint8_t> piece(drafts.size(), 0);
+    for (std::uint32_t r = 0; r < drafts.size(); ++r) {
+        piece[r] = open(r) && (drafts[r].surface.kind != FitKind::kPlane ||
+                               area(r) < kFreeformPlaneShare * comp_area[find(r)]);
+    }
+    const auto curved = [&](std::uint32_t r) { return piece[r] != 0; };
+    components(curved);
+    std::vector<std::vector<std::uint32_t>> groups(drafts.size());
+    for (std::uint32_t r = 0; r < drafts.size(); ++r)
+        if (curved(r)) groups[find(r)].push_back(r);
+    std::uint64_t replaced = 0;
+    for (const auto& g : groups) {
+        if (g.size() < kFreeformMinPieces) continue;
+        std::vector<std::uint32_t> faces;
+        for (const std::uint32_t r : g)
+            faces.insert(faces.end(), drafts[r].faces.begin(), drafts[r].faces.end());
+        PointSet ps;
+        c.gatherers.local().gather(c.m, c.fd, faces, ps);
+        // Unweighted: the smoothing term is scaled to the weights, and area weights (tiny
+        // near dense borders) let the net drift there (0.46 against 0.036 on a coarse die).
+        FitResult r = fit_bspline(FitInput{ps.points, ps.normals, {}}, c.sag);
+        if (!r.ok || r.max > c.sag ||
+            r.surface.bspline->num_u * r.surface.bspline->num_v > kFreeformMaxPoles)
+            continue;
+        if (!chords_agree(c, r.surface, faces)) continue;
+        std::sort(faces.begin(), faces.end());
+        drafts[g.front()].faces = std::move(faces);
+        drafts[g.front()].surface = r.surface;
+        for (std::size_t i = 1; i < g.size(); ++i) {
+            drafts[g[i]].alive = false;
+            drafts[g[i]].faces.clear();
+        }
+        ++replaced;
+    }
+    return replaced;
+}
+
+/// Small regions whose facets each fit a neighbouring region's surface are dissolved into
+/// them: the leftovers of growing where three faces meet (a facet of the fillet and one of the
+/// corner torus, coplanar within the tolerance, grown together as a plane). Returns the facets
+/// moved.
+std::uint64_t absorb_small_regions(Context& c, std::vector<Draft>& drafts) {
+    std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    std::uint64_t moved = 0;
+    bool changed = true;
+    for (int round = 0; round < kRefineRounds && changed; ++round) {
+        changed = false;
+        for (std::uint32_t r = 0; r < drafts.size(); ++r) {
+            Draft& d = drafts[r];
+            if (!d.alive || d.surface_index >= 0 || d.faces.size() > kSmallRegion) continue;
+            std::vector<std::uint32_t> kept;
+            for (const std::uint32_t f : d.faces) {
+                std::uint32_t best = kNone;
+                double best_cost = c.tol;
+                for (const std::uint32_t g : c.fd.adj[f]) {
+                    if (g == kNone) continue;
+                    const std::uint32_t other = region[g];
+                    if (other == r || other == kNone || drafts[other].surface_index >= 0) continue;
+                    const double cost = facet_cost(c, drafts[other].surface, f);
+                    if (cost <= best_cost) best_cost = cost, best = other;
+                }
+                if (best == kNone) {
+                    kept.push_back(f);
+                    continue;
+                }
+                region[f] = best;
+                drafts[best].faces.push_back(f);
+                ++moved;
+                changed = true;
+            }
+            d.faces = std::move(kept);
+            if (d.faces.empty()) d.alive = false;
+        }
+    }
+    return moved;
+}
+
+/// Moves border facets to the neighbouring region they fit clearly better (kRefineRounds
+/// rounds, all moves of a round decided before any is made). Returns the facets moved.
+std::uint64_t refine_borders(Context& c, std::vector<Draft>& drafts) {
+    std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    const std::size_t nf = c.m.num_faces();
+    std::vector<std::uint32_t> target(nf, kNone);
+    std::uint64_t moved = 0;
+    for (int round = 0; round < kRefineRounds; ++round) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 1024), [&](const auto& rng) {
+            for (std::size_t f = rng.begin(); f != rng.end(); ++f) {
+                target[f] = kNone;
+                const std::uint32_t own = region[f];
+                if (own == kNone || drafts[own].surface_index >= 0) continue;
+                std::uint32_t best = kNone;
+                double own_cost = -1, best_cost = kInf;
+                for (const std::uint32_t g : c.fd.adj[f]) {
+                    if (g == kNone) continue;
+                    const std::uint32_t other = region[g];
+                    if (other == own || other == kNone || other == best ||
+                        drafts[other].surface_index >= 0)
+                        continue;
+                    if (own_cost < 0)
+                        own_cost =
+                            facet_cost(c, drafts[own].surface, static_cast<std::uint32_t>(f));
+                    const double cost =
+                        facet_cost(c, drafts[other].surface, static_cast<std::uint32_t>(f));
+                    if (cost < best_cost) best_cost = cost, best = other;
+                }
+                if (best != kNone && best_cost <= c.tol &&
+                    best_cost + kMoveMargin * c.tol < own_cost)
+                    target[f] = best;
+            }
+        });
+        std::vector<std::uint64_t> size(drafts.size(), 0);
+        for (std::size_t r = 0; r < drafts.size(); ++r) size[r] = drafts[r].faces.size();
+        std::uint64_t round_moves = 0;
+        for (std::size_t f = 0; f < nf; ++f) {
+            if (target[f] == kNone || size[region[f]] <= 1) continue;
+            --size[region[f]];
+            ++size[target[f]];
+            region[f] = target[f];
+            ++round_moves;
+        }
+        moved += round_moves;
+        if (round_moves == 0) break;
+    }
+    if (moved) {
+        for (Draft& d : drafts) d.faces.clear();
+        for (std::uint32_t f = 0; f < nf; ++f)
+            if (region[f] != kNone) drafts[region[f]].faces.push_back(f);
+    }
+    return moved;
+}
+
+/// The simplest kind in kKindOrder within the tolerance whose facets are its chords, unless a
+/// later kind that also passes has a clearly lower RMS (as fit_simplest(): a narrow strip of a
+/// cone fits a cylinder within a loose tolerance, but worse). `fallback` when none passes.
+FitResult select_kind(const Context& c, const FitInput& in, std::span<const std::uint32_t> faces,
+                      const FitResult& fallback) {
+    std::vector<FitResult> passing;
+    for (const FitKind kind : kKindOrder) {
+        if (in.points.size() < kMinVertices[static_cast<int>(kind)]) continue;
+        FitResult r = fit(kind, in);
+        if (r.ok && r.max <= c.tol && chords_agree(c, r.surface, faces))
+            passing.push_back(std::move(r));
+    }
+    if (passing.empty()) return fallback;
+    double best_rms = kInf;
+    for (const FitResult& r : passing) best_rms = std::min(best_rms, r.rms);
+    for (const FitResult& r : passing)
+        if (r.rms <= kSignificantRms * best_rms + kRmsFloor * c.tol) return r;
+    return passing.front();
+}
+
+/// The final fit of a region: the simplest kind within the tolerance (method.md Step 4) among
+/// plane to torus, else the surface it was grown with, refitted when it is a B-spline.
+Region final_region(Context& c, const Draft& d, std::span<const SurfaceRecord> records) {
+    Region out;
+    out.surface_index = d.surface_index;
+    out.facets = d.faces.size();
+    for (const std::uint32_t f : d.faces) out.area += c.fd.area[f];
+    PointSet ps;
+    c.gatherers.local().gather(c.m, c.fd, d.faces, ps);
+    const FitInput in = ps.input();
+    const auto residuals = [&](const Surface& s) {
+        FitResult r;
+        r.ok = true;
+        r.surface = s;
+        double sum = 0, wsum = 0;
+        for (std::size_t i = 0; i < ps.points.size(); ++i) {
+            const double e = distance(s, ps.points[i]);
+            sum += ps.weights[i] * e * e;
+            wsum += ps.weights[i];
+            r.max = std::max(r.max, e);
+        }
+        r.rms = wsum > 0 ? std::sqrt(sum / wsum) : 0;
+        return r;
+    };
+    if (d.surface_index >= 0) {
+        out.fit =
+            residuals(surface_from_record(records[static_cast<std::size_t>(d.surface_index)]));
+    } else if (d.surface.kind == FitKind::kBSpline) {
+        out.fit = fit_bspline(FitInput{ps.points, ps.normals, {}}, c.sag);  // as merge_freeform()
+        if (!out.fit.ok) out.fit = residuals(d.surface);
+    } else {
+        // The kind the region was grown and merged with, refitted, when it still holds: the
+        // RMS comparison of select_kind() would turn a plane that took in a facet of the
+        // fillet beside it into a torus.
+        out.fit = residuals(d.surface);
+        FitResult same = fit(d.surface.kind, in);
+        if (same.ok && same.max <= c.tol && chords_agree(c, same.surface, d.faces))
+            out.fit = std::move(same);
+        else
+            out.fit = select_kind(c, in, d.faces, out.fit);
+    }
+    out.within_tolerance =
+        out.fit.ok && out.fit.max <= (out.fit.surface.kind == FitKind::kBSpline ? c.sag : c.tol);
+    return out;
+}
+
+/// Regions numbered in the order of their first face; faces labelled; final fits.
+void finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRecord> records,
+            SegmentResult& result) {
+    std::vector<std::uint32_t> order;
+    for (std::uint32_t r = 0; r < drafts.size(); ++r) {
+        if (drafts[r].alive && !drafts[r].faces.empty()) {
+            std::sort(drafts[r].faces.begin(), drafts[r].faces.end());
+            order.push_back(r);
+        }
+    }
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return drafts[a].faces.front() < drafts[b].faces.front();
+    });
+    result.region = FaceMap<std::int32_t>(c.m.num_faces(), -1);
+    result.regions.resize(order.size());
+    tbb::parallel_for(std::size_t{0}, order.size(), [&](std::size_t i) {
+        result.regions[i] = final_region(c, drafts[order[i]], records);
+        result.regions[i].id = static_cast<std::int32_t>(i);
+    });
+    for (std::size_t i = 0; i < order.size(); ++i)
+        for (const std::uint32_t f : drafts[order[i]].faces)
+            result.region[fid(f)] = static_cast<std::int32_t>(i);
+}
+
+/// One draft per SRE surface index present; mask[f] = 1 for the faces left to segment.
+std::vector<Draft> given_regions(const Mesh& m, std::span<const SurfaceRecord> records, bool use,
+                                 std::vector<std::uint8_t>& mask, std::uint64_t& given) {
+    const std::size_t nf = m.num_faces();
+    mask.assign(nf, 1);
+    std::vector<Draft> drafts;
+    given = 0;
+    if (!use || !m.has_attributes() || records.empty()) return drafts;
+    std::vector<std::uint32_t> draft_of(records.size(), kNone);
+    const auto surf = m.surfaces();
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        const std::int32_t s = surf[f];
+        if (s < 0 || static_cast<std::size_t>(s) >= records.size()) continue;
+        if (draft_of[static_cast<std::size_t>(s)] == kNone) {
+            draft_of[static_cast<std::size_t>(s)] = static_cast<std::uint32_t>(drafts.size());
+            drafts.emplace_back();
+            drafts.back().surface_index = s;
+            drafts.back().surface = surface_from_record(records[static_cast<std::size_t>(s)]);
+        }
+        drafts[draft_of[static_cast<std::size_t>(s)]].faces.push_back(f);
+        mask[f] = 0;
+        ++given;
+    }
+    return drafts;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Paper method.
+
+std::vector<Draft> paper_regions(Context& c, const std::vector<std::uint8_t>& mask,
+                                 const CurvatureOptions& co, SegmentResult& result);
+
+}  // namespace
+
+Surface surface_from_record(const SurfaceRecord& rec) {
+    const auto& p = rec.params;
+    Surface s;
+    const auto unit = [](double x, double y, double z) {
+        const Vec3 v{x, y, z};
+        const double l = norm(v);
+        return l > 0 ? v / l : Vec3{0, 0, 1};
+    };
+    switch (rec.kind) {
+        case SurfaceKind::kPlane:
+            s.kind = FitKind::kPlane;
+            s.point = {p[0], p[1], p[2]};
+            s.axis = unit(p[3], p[4], p[5]);
+            break;
+        case SurfaceKind::kCylinder:
+            s.kind = FitKind::kCylinder;
+            s.point = {p[0], p[1], p[2]};
+            s.axis = unit(p[3], p[4], p[5]);
+            s.radius = p[6];
+            break;
+        case SurfaceKind::kCone:
+            s.kind = FitKind::kCone;
+            s.point = {p[0], p[1], p[2]};
+            s.axis = unit(p[3], p[4], p[5]);
+            s.radius = p[6];
+            s.angle = p[7];
+            break;
+        case SurfaceKind::kSphere:
+            s.kind = FitKind::kSphere;
+            s.point = {p[0], p[1], p[2]};
+            s.radius = p[3];
+            break;
+        case SurfaceKind::kTorus:
+            s.kind = FitKind::kTorus;
+            s.point = {p[0], p[1], p[2]};
+            s.axis = unit(p[3], p[4], p[5]);
+            s.radius = p[6];
+            s.minor_radius = p[7];
+            break;
+        case SurfaceKind::kShearCylinder:
+            s.kind = FitKind::kShearCylinder;
+            s.point = {p[0], p[1], p[2]};
+            s.axis = unit(p[3], p[4], p[5]);
+            s.radius = p[6];
+            s.sweep = unit(p[7], p[8], p[9]);
+            break;
+        case SurfaceKind::kSweptTorus:
+            s.kind = FitKind::kSweptTorus;
+            s.point = {p[0], p[1], p[2]};
+            s.axis = unit(p[3], p[4], p[5]);
+            s.radius = p[6];
+            s.minor_radius = p[7];
+            s.sweep = unit(p[8], p[9], p[10]);
+            break;
+    }
+    return s;
+}
+
+double default_segment_tolerance(const Mesh& m, std::string* rule) {
+    Box3 box;
+    double max_abs = 0;
+    bool all_float = true;
+    for (const Vec3& p : m.positions()) {
+        box.add(p);
+        for (const double x : {p.x, p.y, p.z}) {
+            max_abs = std::max(max_abs, std::abs(x));
+            all_float = all_float && static_cast<double>(static_cast<float>(x)) == x;
+        }
+    }
+    const double diag = m.num_vertices() ? norm(box.max - box.min) : 0;
+    const double by_size = kSegmentRelativeTolerance * diag;
+    const double precision = max_abs * (all_float ? 0x1.0p-24 : 0x1.0p-53);
+    const double by_precision = kPrecisionFactor * precision;
+    if (rule) {
+        *rule = by_size >= by_precision
+                    ? "2e-4 x the bounding-box diagonal"
+                    : "16 x the coordinates' rounding unit (above 2e-4 x the diagonal)";
+    }
+    return std::max(by_size, by_precision);
+}
+
+Result<SegmentResult> segment(const Mesh& m, const SegmentOptions& options,
+                              const ProgressFn& progress) {
+    if (!std::isfinite(options.tolerance) || !std::isfinite(options.sharp_angle)) {
+        return Error{ErrorCode::kBadValue, "tolerance and sharp angle must be finite", {}, -1, -1};
+    }
+    const auto t0 = Clock::now();
+    SegmentResult result;
+    result.method = options.method;
+    Context c(m);
+    if (options.tolerance > 0) {
+        c.tol = options.tolerance;
+        result.tolerance_rule = "given";
+    } else {
+        c.tol = default_segment_tolerance(m, &result.tolerance_rule);
+    }
+    result.tolerance = c.tol;
+    c.sharp = options.sharp_angle > 0 ? options.sharp_angle : kDefaultSegmentSharpAngle;
+    result.sharp_angle = c.sharp;
+    c.cos_normal = std::cos(kSegmentNormalAngle);
+    if (progress) progress("segment", 0.0);
+    c.fd = face_data(m);
+    c.sharp_edge.assign(m.num_halfedges(), 0);
+    c.edge_turn.assign(m.num_halfedges(), 0.0f);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, m.num_halfedges(), 4096), [&](const auto& r) {
+            for (std::size_t h = r.begin(); h != r.end(); ++h) {
+                const double turn =
+                    std::abs(dihedral_angle(m, HalfedgeId(static_cast<std::uint32_t>(h))));
+                c.edge_turn[h] = static_cast<float>(turn);
+                c.sharp_edge[h] = turn >= c.sharp;
+            }
+        });
+    c.sag = estimate_sag(c);
+    result.chordal_deflection = c.sag;
+    std::vector<std::uint8_t> mask;
+    std::vector<Draft> drafts =
+        given_regions(m, options.surfaces, options.use_surface_indices, mask, result.given_facets);
+    if (options.method == SegmentMethod::kFacets) {
+        const auto patches = smooth_patches(c, mask);
+        result.patches = patches.size();
+        const std::size_t nf = m.num_faces();
+        std::vector<std::uint32_t> patch_of(nf, kNone), owner(nf, kNone), queued(nf, kNone),
+            depth(nf, kNone);
+        for (std::uint32_t i = 0; i < patches.size(); ++i)
+            for (const std::uint32_t f : patches[i]) patch_of[f] = i;
+        std::vector<std::vector<Draft>> grown(patches.size());
+        tbb::parallel_for(std::size_t{0}, patches.size(), [&](std::size_t i) {
+            grown[i] = grow_patch(c, patches[i], patch_of, owner, queued, depth,
+                                  static_cast<std::uint32_t>(i));
+        });
+        for (auto& g : grown)
+            for (Draft& d : g) drafts.push_back(std::move(d));
+    } else {
+        const auto tc = Clock::now();
+        auto more = paper_regions(c, mask, options.curvature, result);
+        result.curvature_seconds = seconds_since(tc);
+        for (Draft& d : more) drafts.push_back(std::move(d));
+    }
+    if (progress) progress("segment", 0.5);
+    result.merges = merge_regions(c, drafts);
+    result.freeform_groups = merge_freeform(c, drafts);
+    // Border refinement is the facets method's (the paper assigns facets from their vertices).
+    if (options.method == SegmentMethod::kFacets) {
+        result.reassigned_facets = absorb_small_regions(c, drafts);
+        result.reassigned_facets += refine_borders(c, drafts);
+    }
+    result.segment_seconds = seconds_since(t0) - result.curvature_seconds;
+    if (progress) progress("segment", 1.0);
+    const auto tf = Clock::now();
+    if (progress) progress("fit", 0.0);
+    finish(c, drafts, options.surfaces, result);
+    result.fit_seconds = seconds_since(tf);
+    if (progress) progress("fit", 1.0);
+    return result;
+}
+
+std::vector<std::int32_t> input_labels(const Mesh& m, const SegmentResult& result,
+                                       std::size_t input_facets) {
+    std::vector<std::int32_t> labels(input_facets, -1);
+    for (std::uint32_t f = 0; f < m.num_faces(); ++f) {
+        const std::uint32_t s = m.source_face(fid(f));
+        if (s < input_facets) labels[s] = result.region[fid(f)];
+    }
+    return labels;
+}
+
+std::vector<std::byte> encode_segments_ply(const Mesh& m, const SegmentResult& result) {
+    const std::size_t nf = m.num_faces();
+    std::vector<std::array<std::uint32_t, 3>> triangles(nf);
+    using Type = PlyColumn::Type;
+    std::vector<PlyColumn> columns = {{"region", Type::kInt32, {}},
+                                      {"red", Type::kUint8, {}},
+                                      {"green", Type::kUint8, {}},
+                                      {"blue", Type::kUint8, {}}};
+    for (PlyColumn& col : columns) col.values.resize(nf);
+    for (std::size_t f = 0; f < nf; ++f) {
+        const FaceId ff = fid(static_cast<std::uint32_t>(f));
+        triangles[f] = {m.vertex(ff, 0).idx(), m.vertex(ff, 1).idx(), m.vertex(ff, 2).idx()};
+        const std::int32_t r = result.region[ff];
+        const std::uint32_t rgb = r >= 0 ? label_color(static_cast<std::uint32_t>(r)) : 0x808080u;
+        columns[0].values[f] = r;
+        columns[1].values[f] = (rgb >> 16) & 0xff;
+        columns[2].values[f] = (rgb >> 8) & 0xff;
+        columns[3].values[f] = rgb & 0xff;
+    }
+    return encode_ply(m.positions(), triangles, {}, columns);
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// The paper's method (method.md 3.3-3.6).
+
+std::vector<Draft> paper_regions(Context& c, const std::vector<std::uint8_t>& mask,
+                                 const CurvatureOptions& co, SegmentResult& result) {
+    const Mesh& m = c.m;
+    const std::size_t nv = m.num_vertices(), nf = m.num_faces();
+    const CurvatureResult cr = compute_curvature(m, co);
+    const VertexMap<double> area = mixed_voronoi_areas(m);
+    // Vertices to cluster: those of a face left to segment, not high-curvature.
+    std::vector<std::uint8_t> active(nv, 0);
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        if (!mask[f]) continue;
+        for (int i = 0; i < 3; ++i) active[m.vertex(fid(f), i).idx()] = 1;
+    }
+    constexpr std::uint8_t kHigh = 255;
+    std::vector<std::uint8_t> type(nv, kHigh);
+    for (std::uint32_t v = 0; v < nv; ++v) {
+        if (active[v] && !cr.field.high[VertexId(v)])
+            type[v] = static_cast<std::uint8_t>(cr.field.type[VertexId(v)]);
+    }
+    // 3.5 Refining: each vertex takes the type with the largest area in its closed one-ring.
+    std::vector<std::uint8_t> next = type;
+    for (int round = 0; round < kPaperRefineRounds; ++round) {
+        std::atomic<bool> changed{false};
+        tbb::parallel_for(
+            tbb::blocked_range<std::uint32_t>(0, static_cast<std::uint32_t>(nv), 4096),
+            [&](const auto& r) {
+                for (std::uint32_t v = r.begin(); v != r.end(); ++v) {
+                    next[v] = type[v];
+                    if (type[v] == kHigh) continue;
+                    std::array<double, kNumShapeTypes> score{};
+                    score[type[v]] += area[VertexId(v)];
+                    m.for_each_neighbour(VertexId(v), [&](VertexId w) {
+                        if (type[w.idx()] != kHigh) score[type[w.idx()]] += area[w];
+                    });
+                    std::uint8_t best = type[v];
+                    for (std::uint8_t t = 0; t < kNumShapeTypes; ++t)
+                        if (score[t] > score[best]) best = t;
+                    if (best != type[v]) {
+                        next[v] = best;
+                        changed = true;
+                    }
+                }
+            });
+        type.swap(next);
+        if (!changed) break;
+    }
+    // 3.6 Connected components of same-type vertices.
+    std::vector<std::uint32_t> comp(nv, kNone);
+    std::vector<std::vector<std::uint32_t>> comps;
+    std::vector<std::uint32_t> stack;
+    for (std::uint32_t v = 0; v < nv; ++v) {
+        if (type[v] == kHigh || comp[v] != kNone) continue;
+        const std::uint32_t id = static_cast<std::uint32_t>(comps.size());
+        comps.emplace_back();
+        comp[v] = id;
+        stack.assign(1, v);
+        while (!stack.empty()) {
+            const std::uint32_t x = stack.back();
+            stack.pop_back();
+            comps[id].push_back(x);
+            m.for_each_neighbour(VertexId(x), [&](VertexId w) {
+                if (comp[w.idx()] == kNone && type[w.idx()] == type[x]) {
+                    comp[w.idx()] = id;
+                    stack.push_back(w.idx());
+                }
+            });
+        }
+    }
+    result.patches = comps.size();
+    // The set-aside vertices join the nearest component along edges (breadth first, in
+    // vertex order: deterministic).
+    {
+        std::vector<std::uint32_t> frontier;
+        for (std::uint32_t v = 0; v < nv; ++v)
+            if (comp[v] != kNone) frontier.push_back(v);
+        std::vector<std::uint32_t> nxt;
+        while (!frontier.empty()) {
+            nxt.clear();
+            for (const std::uint32_t x : frontier) {
+                m.for_each_neighbour(VertexId(x), [&](VertexId w) {
+                    if (comp[w.idx()] == kNone && active[w.idx()]) {
+                        comp[w.idx()] = comp[x];
+                        nxt.push_back(w.idx());
+                    }
+                });
+            }
+            frontier.swap(nxt);
+        }
+    }
+    // Facets: the component of two or three of their vertices, else of the first corner whose
+    // component's vertices it fits best (decided below, after the components are fitted).
+    std::vector<Draft> drafts(comps.size());
+    std::vector<std::uint32_t> undecided;
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        if (!mask[f]) continue;
+        const std::uint32_t a = comp[m.vertex(fid(f), 0).idx()],
+                            b = comp[m.vertex(fid(f), 1).idx()],
+                            d = comp[m.vertex(fid(f), 2).idx()];
+        std::uint32_t r = kNone;
+        if (a == b || a == d)
+            r = a;
+        else if (b == d)
+            r = b;
+        if (r != kNone)
+            drafts[r].faces.push_back(f);
+        else
+            undecided.push_back(f);
+    }
+    // Fit every component's facets (the paper's merging needs each region's surface).
+    tbb::parallel_for(std::size_t{0}, drafts.size(), [&](std::size_t i) {
+        Draft& d = drafts[i];
+        if (d.faces.empty()) {
+            d.alive = false;
+            return;
+        }
+        if (auto r = fit_faces(c, d.faces)) {
+            d.surface = r->surface;
+            return;
+        }
+        PointSet ps;
+        c.gatherers.local().gather(c.m, c.fd, d.faces, ps);
+        FitResult best;
+        double best_max = kInf;
+        for (int k = 0; k < 5; ++k) {
+            FitResult r = fit(static_cast<FitKind>(k), ps.input());
+            if (r.ok && r.max < best_max) best_max = r.max, best = r;
+        }
+        if (best.ok)
+            d.surface = best.surface;
+        else {
+            d.surface.kind = FitKind::kPlane;
+            d.surface.point = c.fd.centroid[d.faces.front()];
+            d.surface.axis = c.fd.normal[d.faces.front()];
+        }
+    });
+    for (const std::uint32_t f : undecided) {
+        std::uint32_t best = kNone;
+        double best_cost = kInf;
+        for (int i = 0; i < 3; ++i) {
+            const std::uint32_t r = comp[m.vertex(fid(f), i).idx()];
+            if (r == kNone || !drafts[r].alive) continue;
+            const double cost = facet_cost(c, drafts[r].surface, f);
+            if (best == kNone || cost < best_cost) best = r, best_cost = cost;
+        }
+        if (best == kNone) {  // every corner set aside with no component reachable
+            drafts.emplace_back();
+            drafts.back().faces.push_back(f);
+            drafts.back().surface.point = c.fd.centroid[f];
+            drafts.back().surface.axis = c.fd.normal[f];
+            continue;
+        }
+        drafts[best].faces.push_back(f);
+    }
+    return drafts;
+}
+
+}  // namespace
+
+}  // namespace ncrev

@@ -1,0 +1,230 @@
+// Segmentation against the sample parts' truth (every facet knows its face), both methods, fine
+// and coarse; SRE surface indices; labels, PLY; determinism.
+#include "ncrev/segment.h"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <string>
+
+#include "ncrev/mesh.h"
+#include "ncrev/sample.h"
+
+namespace ncrev {
+namespace {
+
+struct Score {
+    double iou = 0;           ///< area-weighted mean over true faces of the best region's IoU
+    std::size_t regions = 0;  ///< regions found
+    std::size_t faces = 0;    ///< true faces with at least one facet
+    double kind_right = 0;    ///< share of the area whose region has the true face's kind
+    double seconds = 0;
+    std::string worst;  ///< the true face with the lowest IoU, for messages
+};
+
+/// The truth kind as fit names it ("bezier" and other free-form kinds are B-splines).
+std::string truth_kind(const std::string& k) {
+    for (const char* a : {"plane", "cylinder", "cone", "sphere", "torus"})
+        if (k == a) return k;
+    return "bspline";
+}
+
+Score score(const Mesh& mesh, const SegmentResult& r, const SamplePart& part) {
+    const std::size_t nf = mesh.num_faces();
+    std::map<std::pair<std::int64_t, std::int32_t>, double> inter;
+    std::map<std::int64_t, double> face_area;
+    std::map<std::int32_t, double> region_area;
+    double total = 0, right = 0;
+    for (std::size_t f = 0; f < nf; ++f) {
+        const FaceId ff(static_cast<std::uint32_t>(f));
+        const double a = mesh.face_area(ff);
+        const std::int64_t t = mesh.cuts()[f];
+        const std::int32_t g = r.region[ff];
+        inter[{t, g}] += a;
+        face_area[t] += a;
+        region_area[g] += a;
+        total += a;
+        const std::string want = truth_kind(part.faces[static_cast<std::size_t>(t)].kind);
+        if (g >= 0 && want == to_string(r.regions[static_cast<std::size_t>(g)].fit.surface.kind))
+            right += a;
+    }
+    std::map<std::int64_t, double> best;
+    for (const auto& [key, a] : inter) {
+        const double u = face_area[key.first] + region_area[key.second] - a;
+        best[key.first] = std::max(best[key.first], a / u);
+    }
+    Score s;
+    double worst = 2;
+    for (const auto& [t, iou] : best) {
+        s.iou += iou * face_area[t] / total;
+        if (iou < worst) {
+            worst = iou;
+            s.worst = "face " + std::to_string(t) + " (" +
+                      part.faces[static_cast<std::size_t>(t)].kind + ") IoU " + std::to_string(iou);
+        }
+    }
+    s.regions = r.regions.size();
+    s.faces = face_area.size();
+    s.kind_right = right / total;
+    return s;
+}
+
+struct Case {
+    SamplePart part;
+    Mesh mesh;
+};
+
+Case make_case(std::string_view name, double relative_deflection) {
+    SampleOptions so;
+    so.with_step = false;
+    so.relative_deflection = relative_deflection;
+    Result<SamplePart> made = make_sample_part(name, so);
+    EXPECT_TRUE(made.ok()) << name;
+    Result<BuildResult> b = build_mesh(made.value().mesh);
+    EXPECT_TRUE(b.ok());
+    return {std::move(made).value(), std::move(b.value().mesh)};
+}
+
+Score run(const Case& c, SegmentMethod method) {
+    SegmentOptions o;
+    o.method = method;
+    const auto t0 = std::chrono::steady_clock::now();
+    Result<SegmentResult> r = segment(c.mesh, o);
+    const double secs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_TRUE(r.ok());
+    Score s = score(c.mesh, r.value(), c.part);
+    s.seconds = secs;
+    return s;
+}
+
+constexpr double kFine = kSampleRelativeDeflection;
+constexpr double kCoarse = 4 * kSampleRelativeDeflection;
+
+// The table of docs/segmentation.md:
+//   build/bin/ncrev_tests --gtest_also_run_disabled_tests --gtest_filter='SegmentStudy.*'
+TEST(SegmentStudy, DISABLED_Table) {
+    std::printf(
+        "| part | mesh | facets | faces | facets: IoU | regions | kind | s | paper: IoU | "
+        "regions | kind | s |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    double sum[2][3] = {};
+    int n = 0;
+    for (const SamplePartInfo& info : sample_parts()) {
+        for (const double d : {kFine, kCoarse}) {
+            const Case c = make_case(info.name, d);
+            const Score a = run(c, SegmentMethod::kFacets);
+            const Score b = run(c, SegmentMethod::kPaper);
+            ++n;
+            int k = 0;
+            for (const Score* x : {&a, &b}) {
+                sum[k][0] += x->iou;
+                sum[k][1] += x->regions == x->faces;
+                sum[k][2] += x->kind_right;
+                ++k;
+            }
+            std::printf(
+                "| %s | %s | %zu | %zu | %.4f | %zu | %.4f | %.2f | %.4f | %zu | %.4f | "
+                "%.2f |\n",
+                std::string(info.name).c_str(), d == kFine ? "fine" : "coarse", c.mesh.num_faces(),
+                a.faces, a.iou, a.regions, a.kind_right, a.seconds, b.iou, b.regions, b.kind_right,
+                b.seconds);
+            if (a.iou < 0.98) std::printf("    facets worst: %s\n", a.worst.c_str());
+        }
+    }
+    for (int k = 0; k < 2; ++k) {
+        std::printf("%s: mean IoU %.4f, count right %.0f/%d, kind %.4f\n",
+                    k == 0 ? "facets" : "paper", sum[k][0] / n, sum[k][1], n, sum[k][2] / n);
+    }
+}
+
+}  // namespace
+}  // namespace ncrev
+namespace ncrev {
+TEST(SegmentStudy, DISABLED_Debug) {
+    const char* name = std::getenv("PART") ? std::getenv("PART") : "l_bracket";
+    const Case c = make_case(name, std::getenv("COARSE") ? kCoarse : kFine);
+    SegmentOptions o;
+    Result<SegmentResult> r = segment(c.mesh, o);
+    const SegmentResult& s = r.value();
+    std::printf("sag %g tol %g patches %llu merges %llu freeform %llu moved %llu\n",
+                s.chordal_deflection, s.tolerance, (unsigned long long)s.patches,
+                (unsigned long long)s.merges, (unsigned long long)s.freeform_groups,
+                (unsigned long long)s.reassigned_facets);
+    for (std::size_t f = 0; f < c.mesh.num_faces(); ++f) {
+        const FaceId ff(static_cast<std::uint32_t>(f));
+        const Region& g = s.regions[static_cast<std::size_t>(s.region[ff])];
+        if (g.facets > 3) continue;
+        for (int i = 0; i < 3; ++i) {
+            const HalfedgeId t = c.mesh.twin(Mesh::halfedge(ff, i));
+            if (!t.is_valid()) continue;
+            const Region& nb = s.regions[static_cast<std::size_t>(s.region[Mesh::face(t)])];
+            if (nb.facets <= 3) continue;
+            double dmax = 0;
+            Vec3 cen{0, 0, 0};
+            for (int k = 0; k < 3; ++k) {
+                const Vec3 p = c.mesh.position(c.mesh.vertex(ff, k));
+                dmax = std::max(dmax, distance(nb.fit.surface, p));
+                cen += p / 3.0;
+            }
+            const Vec3 n = c.mesh.face_normal(ff);
+            const Vec3 q = cen + n * 0.05;
+            const Vec3 sn = normalized(q - closest_point(nb.fit.surface, q));
+            std::printf(
+                "small %d facet %zu vs region %d (%s): corners %g centroid %g normal cos %g\n",
+                g.id, f, nb.id, to_string(nb.fit.surface.kind), dmax, distance(nb.fit.surface, cen),
+                std::abs(dot(sn, n)));
+        }
+    }
+    std::map<std::pair<std::int32_t, std::int64_t>, int> m;
+    for (std::size_t f = 0; f < c.mesh.num_faces(); ++f)
+        ++m[{s.region[FaceId(static_cast<std::uint32_t>(f))], c.mesh.cuts()[f]}];
+    for (const auto& [k, n] : m) {
+        const Region& g = s.regions[static_cast<std::size_t>(k.first)];
+        std::printf("region %d (%s r=%g ax %g %g %g max %g) truth %lld (%s) facets %d\n", k.first,
+                    to_string(g.fit.surface.kind), g.fit.surface.radius, g.fit.surface.axis.x,
+                    g.fit.surface.axis.y, g.fit.surface.axis.z, g.fit.max, (long long)k.second,
+                    c.part.faces[static_cast<std::size_t>(k.second)].kind.c_str(), n);
+    }
+}
+}  // namespace ncrev
+namespace ncrev {
+TEST(SegmentStudy, DISABLED_FreeformFace) {
+    const Case c = make_case("freeform_die", std::getenv("COARSE") ? kCoarse : kFine);
+    std::vector<Vec3> pts;
+    std::vector<std::uint8_t> seen(c.mesh.num_vertices(), 0);
+    for (std::size_t f = 0; f < c.mesh.num_faces(); ++f) {
+        if (c.part.faces[static_cast<std::size_t>(c.mesh.cuts()[f])].kind == "plane") continue;
+        for (int k = 0; k < 3; ++k) {
+            const VertexId v = c.mesh.vertex(FaceId(static_cast<std::uint32_t>(f)), k);
+            if (!seen[v.idx()]) seen[v.idx()] = 1, pts.push_back(c.mesh.position(v));
+        }
+    }
+    const double tol = default_segment_tolerance(c.mesh);
+    const FitResult r = fit_bspline(FitInput{pts, {}, {}}, tol);
+    std::printf("points %zu tol %g ok %d max %g rms %g net %d x %d %s\n", pts.size(), tol, r.ok,
+                r.max, r.rms, r.ok ? r.surface.bspline->num_u : 0,
+                r.ok ? r.surface.bspline->num_v : 0, r.failure.c_str());
+}
+}  // namespace ncrev
+namespace ncrev {
+TEST(SegmentStudy, DISABLED_FaceDihedrals) {
+    const char* name = std::getenv("PART") ? std::getenv("PART") : "freeform_die";
+    const Case c = make_case(name, std::getenv("COARSE") ? kCoarse : kFine);
+    std::map<std::int64_t, double> worst;
+    for (std::uint32_t h = 0; h < c.mesh.num_halfedges(); ++h) {
+        const HalfedgeId t = c.mesh.twin(HalfedgeId(h));
+        if (!t.is_valid()) continue;
+        const auto a = c.mesh.cuts()[Mesh::face(HalfedgeId(h)).idx()],
+                   b = c.mesh.cuts()[Mesh::face(t).idx()];
+        if (a != b) continue;
+        worst[a] = std::max(worst[a], std::abs(dihedral_angle(c.mesh, HalfedgeId(h))) * 57.2958);
+    }
+    for (const auto& [f, w] : worst)
+        std::printf("face %lld %s max dihedral %.1f deg\n", (long long)f,
+                    c.part.faces[static_cast<std::size_t>(f)].kind.c_str(), w);
+}
+}  // namespace ncrev
