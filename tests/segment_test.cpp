@@ -157,12 +157,12 @@ TEST(SegmentStudy, DISABLED_Debug) {
     for (std::size_t f = 0; f < c.mesh.num_faces(); ++f) {
         const FaceId ff(static_cast<std::uint32_t>(f));
         const Region& g = s.regions[static_cast<std::size_t>(s.region[ff])];
-        if (g.facets > 3) continue;
+        if (g.facets > 4) continue;
         for (int i = 0; i < 3; ++i) {
             const HalfedgeId t = c.mesh.twin(Mesh::halfedge(ff, i));
             if (!t.is_valid()) continue;
             const Region& nb = s.regions[static_cast<std::size_t>(s.region[Mesh::face(t)])];
-            if (nb.facets <= 3) continue;
+            if (nb.facets <= 4) continue;
             double dmax = 0;
             Vec3 cen{0, 0, 0};
             for (int k = 0; k < 3; ++k) {

@@ -250,13 +250,13 @@ bool normal_agrees(const Context& c, const Surface& s, std::uint32_t f) {
 /// How badly facet f fits s: the largest distance of its corners; infinite when its normal
 /// disagrees with the surface's or its middle is further from the surface than the mesh's
 /// chordal deflection (a chord of the surface: corners on it, middle within the sag).
-double facet_cost(const Context& c, const Surface& s, std::uint32_t f) {
+double facet_cost(const Context& c, const Surface& s, std::uint32_t f, bool check_normal = true) {
     double worst = 0;
     for (int i = 0; i < 3; ++i)
         worst = std::max(worst, distance(s, c.m.position(c.m.vertex(fid(f), i))));
     if (worst > c.tol) return worst;
     if (distance(s, c.fd.centroid[f]) > c.sag) return kInf;
-    return normal_agrees(c, s, f) ? worst : kInf;
+    return !check_normal || normal_agrees(c, s, f) ? worst : kInf;
 }
 
 bool facet_fits(const Context& c, const Surface& s, std::uint32_t f) {
@@ -689,7 +689,9 @@ std::uint64_t absorb_small_regions(Context& c, std::vector<Draft>& drafts) {
                     if (g == kNone) continue;
                     const std::uint32_t other = region[g];
                     if (other == r || other == kNone || drafts[other].surface_index >= 0) continue;
-                    const double cost = facet_cost(c, drafts[other].surface, f);
+                    // No normal test: the neighbour's surface is established, and the leftovers
+                    // are often slivers, whose normals say nothing (see chords_agree()).
+                    const double cost = facet_cost(c, drafts[other].surface, f, false);
                     if (cost <= best_cost) best_cost = cost, best = other;
                 }
                 if (best == kNone) {
@@ -1032,6 +1034,8 @@ Result<SegmentResult> segment(const Mesh& m, const SegmentOptions& options,
     if (options.method == SegmentMethod::kFacets) {
         result.reassigned_facets = absorb_small_regions(c, drafts);
         result.reassigned_facets += refine_borders(c, drafts);
+        // Refining can leave a few facets of two faces on their own again.
+        result.reassigned_facets += absorb_small_regions(c, drafts);
     }
     result.segment_seconds = seconds_since(t0) - result.curvature_seconds;
     if (progress) progress("segment", 1.0);
