@@ -10,6 +10,7 @@
 #include "ncrev/curvature.h"
 #include "ncrev/io.h"
 #include "ncrev/mesh.h"
+#include "ncrev/segment.h"
 
 namespace ncrev {
 
@@ -60,6 +61,23 @@ std::string to_json(const InfoReport& info, const CurvatureResult& curvature, do
 
 /// The curvature summary as a few lines of text: vertices per type, thresholds.
 std::string to_text(const CurvatureResult& curvature, Unit unit);
+
+/// The report of `ncrev segment`: the info keys plus "segment" (method, tolerance, chordal
+/// deflection and sharp angle with their rules, counts, seconds per stage, regions by kind) and
+/// "regions": one object per region, {"id", "kind", "params", "facets", "area", "rms", "max",
+/// "within_tolerance", "surface_index"}; params by kind: plane point, normal; cylinder
+/// axis_point, axis_dir, radius; cone apex, axis_dir (the radius grows along it), half_angle
+/// (rad), radius and axis_point (a section); sphere center, radius; torus center, axis_dir,
+/// major_radius, minor_radius; shear_cylinder center, axis_dir, radius, sweep_dir;
+/// swept_torus center, axis_dir, major_radius, minor_radius, sweep_dir; bspline degree,
+/// num_u, num_v, poles (num_u x num_v points, u fastest).
+std::string to_json(const InfoReport& info, const SegmentResult& segment, int indent = 2);
+
+/// The region parameters of to_json() for one surface.
+std::string surface_params_json(const Surface& surface);
+
+/// The segmentation summary as a few lines of text: regions by kind, tolerance, times.
+std::string to_text(const SegmentResult& segment, Unit unit);
 
 /// The report as a few lines of text for a terminal.
 std::string to_text(const InfoReport& report);

@@ -1,7 +1,9 @@
 #include "ncrev/report.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <map>
 #include <nlohmann/json.hpp>
 
 namespace ncrev {
@@ -202,6 +204,126 @@ std::string to_json(const InfoReport& info, const CurvatureResult& curvature, do
     nlohmann::json j = info_json(info);
     j["curvature"] = curvature_json(curvature, seconds);
     return j.dump(indent);
+}
+
+namespace {
+
+nlohmann::json params_json(const Surface& s) {
+    using nlohmann::json;
+    auto vec = [](Vec3 v) { return json::array({v.x, v.y, v.z}); };
+    switch (s.kind) {
+        case FitKind::kPlane:
+            return {{"point", vec(s.point)}, {"normal", vec(s.axis)}};
+        case FitKind::kCylinder:
+            return {{"axis_point", vec(s.point)}, {"axis_dir", vec(s.axis)}, {"radius", s.radius}};
+        case FitKind::kCone: {
+            // The apex: where the radius, growing along the axis, is zero.
+            const Vec3 apex = s.point - s.axis * (s.radius / std::tan(s.angle));
+            return {{"apex", vec(apex)},         {"axis_dir", vec(s.axis)},
+                    {"half_angle", s.angle},     {"axis_point", vec(s.point)},
+                    {"radius", s.radius}};
+        }
+        case FitKind::kSphere:
+            return {{"center", vec(s.point)}, {"radius", s.radius}};
+        case FitKind::kTorus:
+            return {{"center", vec(s.point)},
+                    {"axis_dir", vec(s.axis)},
+                    {"major_radius", s.radius},
+                    {"minor_radius", s.minor_radius}};
+        case FitKind::kShearCylinder:
+            return {{"center", vec(s.point)},
+                    {"axis_dir", vec(s.axis)},
+                    {"radius", s.radius},
+                    {"sweep_dir", vec(s.sweep)}};
+        case FitKind::kSweptTorus:
+            return {{"center", vec(s.point)},       {"axis_dir", vec(s.axis)},
+                    {"major_radius", s.radius},     {"minor_radius", s.minor_radius},
+                    {"sweep_dir", vec(s.sweep)}};
+        case FitKind::kBSpline: {
+            json poles = json::array();
+            if (s.bspline) {
+                for (const Vec3& p : s.bspline->poles) poles.push_back(vec(p));
+            }
+            return {{"degree", s.bspline ? s.bspline->degree : 3},
+                    {"num_u", s.bspline ? s.bspline->num_u : 0},
+                    {"num_v", s.bspline ? s.bspline->num_v : 0},
+                    {"poles", poles}};
+        }
+    }
+    return json::object();
+}
+
+}  // namespace
+
+std::string surface_params_json(const Surface& surface) { return params_json(surface).dump(); }
+
+std::string to_json(const InfoReport& info, const SegmentResult& r, int indent) {
+    using nlohmann::json;
+    json j = info_json(info);
+    std::map<std::string, std::uint64_t> by_kind;
+    json regions = json::array();
+    for (const Region& g : r.regions) {
+        const char* kind = g.fit.ok ? to_string(g.fit.surface.kind) : "none";
+        ++by_kind[kind];
+        regions.push_back({{"id", g.id},
+                           {"kind", kind},
+                           {"params", g.fit.ok ? params_json(g.fit.surface) : json::object()},
+                           {"facets", g.facets},
+                           {"area", g.area},
+                           {"rms", g.fit.rms},
+                           {"max", g.fit.max},
+                           {"within_tolerance", g.within_tolerance},
+                           {"surface_index", g.surface_index}});
+    }
+    j["segment"] = {{"method", to_string(r.method)},
+                    {"tolerance", r.tolerance},
+                    {"tolerance_rule", r.tolerance_rule},
+                    {"chordal_deflection", r.chordal_deflection},
+                    {"sharp_angle", r.sharp_angle},
+                    {"regions", r.regions.size()},
+                    {"regions_by_kind", by_kind},
+                    {"given_facets", r.given_facets},
+                    {"patches", r.patches},
+                    {"merges", r.merges},
+                    {"freeform_groups", r.freeform_groups},
+                    {"reassigned_facets", r.reassigned_facets},
+                    {"seconds",
+                     {{"curvature", r.curvature_seconds},
+                      {"segment", r.segment_seconds},
+                      {"fit", r.fit_seconds}}}};
+    j["regions"] = std::move(regions);
+    return j.dump(indent);
+}
+
+std::string to_text(const SegmentResult& r, Unit unit) {
+    std::map<std::string, std::uint64_t> by_kind;
+    std::uint64_t outside = 0;
+    for (const Region& g : r.regions) {
+        ++by_kind[g.fit.ok ? to_string(g.fit.surface.kind) : "none"];
+        outside += !g.within_tolerance;
+    }
+    std::string s;
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "segment: %s method, %zu regions (", to_string(r.method),
+                  r.regions.size());
+    s += buf;
+    bool first = true;
+    for (const auto& [k, n] : by_kind) {
+        s += (first ? "" : ", ") + std::to_string(n) + " " + k;
+        first = false;
+    }
+    s += ")\n";
+    std::snprintf(buf, sizeof buf,
+                  "tolerance %.4g %s (%s), chordal deflection %.4g %s, sharp edges from %.1f deg\n",
+                  r.tolerance, to_string(unit), r.tolerance_rule.c_str(), r.chordal_deflection,
+                  to_string(unit), r.sharp_angle * 180 / 3.14159265358979323846);
+    s += buf;
+    if (r.given_facets) s += std::to_string(r.given_facets) + " facets kept their SRE surface\n";
+    if (outside) s += std::to_string(outside) + " regions not within the tolerance of any surface\n";
+    std::snprintf(buf, sizeof buf, "seconds: curvature %.3f, segment %.3f, fit %.3f\n",
+                  r.curvature_seconds, r.segment_seconds, r.fit_seconds);
+    s += buf;
+    return s;
 }
 
 std::string to_text(const CurvatureResult& c, Unit unit) {

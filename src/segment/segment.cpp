@@ -69,6 +69,9 @@ constexpr double kNormalOutlierArea = 0.02;
 constexpr double kFreeformPlaneShare = 0.1;
 /// A region this many times larger than the one it merges with keeps its kind.
 constexpr std::size_t kDominantRatio = 4;
+/// Growing regions are refitted each time they double, up to this many facets: by then the
+/// surface is known far better than the tolerance, and the final fit uses every facet anyway.
+constexpr std::size_t kMaxGrowthRefit = 1u << 14;
 /// See firm_plane().
 constexpr std::size_t kFirmPlaneFacets = 8;
 constexpr double kFirmPlaneShare = 0.25;
@@ -197,7 +200,7 @@ double estimate_sag(const Context& c) {
         const HalfedgeId he(h);
         const HalfedgeId t = m.twin(he);
         if (!t.is_valid() || t.idx() < h || c.sharp_edge[h]) continue;
-        const double beta = std::abs(dihedral_angle(m, he));
+        const double beta = c.edge_turn[h];
         if (beta < kFlatDihedral) continue;  // a plane's edges say nothing of the sag
         const Vec3 a = m.position(m.origin(he)), b = m.position(m.target(he));
         const double len = norm(b - a);
@@ -281,10 +284,19 @@ bool chords_agree(const Context& c, const Surface& s, std::span<const std::uint3
 /// The first kind in kKindOrder (of `kinds`) whose fit keeps every vertex of `faces` within
 /// the tolerance and whose chords the facets are (chords_agree()).
 std::optional<FitResult> fit_faces(Context& c, std::span<const std::uint32_t> faces,
-                                   FitKindSet kinds = kRevolutionFitKinds) {
+                                   FitKindSet kinds = kRevolutionFitKinds,
+                                   std::optional<FitKind> first = std::nullopt) {
     PointSet ps;
     c.gatherers.local().gather(c.m, c.fd, faces, ps);
-    for (const FitKind kind : kKindOrder) {
+    // `first` (the kind a growing region has) is tried before the others: refitting a torus of
+    // a million facets should not fit a plane, a cylinder, a cone and a sphere to it first.
+    std::array<FitKind, 6> order;
+    std::size_t n = 0;
+    if (first) order[n++] = *first;
+    for (const FitKind kind : kKindOrder)
+        if (!first || kind != *first) order[n++] = kind;
+    for (std::size_t i = 0; i < n; ++i) {
+        const FitKind kind = order[i];
         if ((kinds & fit_kind_bit(kind)) == 0) continue;
         if (ps.points.size() < kMinVertices[static_cast<int>(kind)]) continue;
         FitResult r = fit(kind, ps.input());
@@ -430,9 +442,11 @@ std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patc
                 owner[f] = rid;
                 d.faces.push_back(f);
                 push_neighbours(f);
-                if (d.faces.size() >= 2 * last_fit && d.faces.size() >= 16) {
+                if (d.faces.size() >= 2 * last_fit && d.faces.size() >= 16 &&
+                    d.faces.size() <= kMaxGrowthRefit) {
                     // Refit as the region doubles: noise averages out, the kind may change.
-                    if (auto r = fit_faces(c, d.faces)) d.surface = r->surface;
+                    if (auto r = fit_faces(c, d.faces, kRevolutionFitKinds, d.surface.kind))
+                        d.surface = r->surface;
                     last_fit = d.faces.size();
                 }
             }
@@ -449,7 +463,7 @@ std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patc
                 d.faces.size() >= kDominantRatio * rejected.size() || firm_plane(c, d)
                     ? fit_kind_bit(d.surface.kind)
                     : kRevolutionFitKinds;
-            auto r = fit_faces(c, trial, kinds);
+            auto r = fit_faces(c, trial, kinds, d.surface.kind);
             if (!r) {
                 // The second ring: unassigned neighbours of the first, not yet queued.
                 const std::size_t first = trial.size();
@@ -460,7 +474,7 @@ std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patc
                         trial.push_back(g);
                     }
                 }
-                if (trial.size() > first) r = fit_faces(c, trial, kinds);
+                if (trial.size() > first) r = fit_faces(c, trial, kinds, d.surface.kind);
                 if (r) {
                     rejected.assign(trial.begin() + static_cast<std::ptrdiff_t>(d.faces.size()),
                                     trial.end());
