@@ -48,8 +48,7 @@ void BM_SegmentPaperBox(benchmark::State& state) {
         SegmentMethod::kPaper);
 }
 void BM_SegmentPaperTorus(benchmark::State& state) {
-    run(state, cached(torus_soup, static_cast<std::size_t>(state.range(0))),
-        SegmentMethod::kPaper);
+    run(state, cached(torus_soup, static_cast<std::size_t>(state.range(0))), SegmentMethod::kPaper);
 }
 
 #define NCREV_SEGMENT_SIZES \

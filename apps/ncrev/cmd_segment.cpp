@@ -63,8 +63,8 @@ void add_segment(CLI::App& app, Context& ctx) {
         ->check(CLI::PositiveNumber);
     cmd->add_option("--sharp-angle", o->sharp_degrees,
                     "Dihedral angle in degrees from which an edge is sharp (default " +
-                        std::to_string(static_cast<int>(std::lround(
-                            kDefaultSegmentSharpAngle * 180 / std::numbers::pi))) +
+                        std::to_string(static_cast<int>(
+                            std::lround(kDefaultSegmentSharpAngle * 180 / std::numbers::pi))) +
                         ")")
         ->check(CLI::Range(1.0, 179.0));
     cmd->add_flag("--no-surface-indices", o->no_surfaces,
@@ -110,8 +110,8 @@ void add_segment(CLI::App& app, Context& ctx) {
             return;
         }
         if (!o->labels.empty()) {
-            const std::string text = labels_text(
-                input_labels(healed->mesh, r.value(), healed->report.input_facets));
+            const std::string text =
+                labels_text(input_labels(healed->mesh, r.value(), healed->report.input_facets));
             const auto* bytes = reinterpret_cast<const std::byte*>(text.data());
             if (auto s = write_file_atomic(o->labels, {bytes, text.size()}); !s) {
                 print_error(s.error().describe());

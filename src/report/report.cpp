@@ -219,8 +219,10 @@ nlohmann::json params_json(const Surface& s) {
         case FitKind::kCone: {
             // The apex: where the radius, growing along the axis, is zero.
             const Vec3 apex = s.point - s.axis * (s.radius / std::tan(s.angle));
-            return {{"apex", vec(apex)},         {"axis_dir", vec(s.axis)},
-                    {"half_angle", s.angle},     {"axis_point", vec(s.point)},
+            return {{"apex", vec(apex)},
+                    {"axis_dir", vec(s.axis)},
+                    {"half_angle", s.angle},
+                    {"axis_point", vec(s.point)},
                     {"radius", s.radius}};
         }
         case FitKind::kSphere:
@@ -236,8 +238,10 @@ nlohmann::json params_json(const Surface& s) {
                     {"radius", s.radius},
                     {"sweep_dir", vec(s.sweep)}};
         case FitKind::kSweptTorus:
-            return {{"center", vec(s.point)},       {"axis_dir", vec(s.axis)},
-                    {"major_radius", s.radius},     {"minor_radius", s.minor_radius},
+            return {{"center", vec(s.point)},
+                    {"axis_dir", vec(s.axis)},
+                    {"major_radius", s.radius},
+                    {"minor_radius", s.minor_radius},
                     {"sweep_dir", vec(s.sweep)}};
         case FitKind::kBSpline: {
             json poles = json::array();
@@ -319,7 +323,8 @@ std::string to_text(const SegmentResult& r, Unit unit) {
                   to_string(unit), r.sharp_angle * 180 / 3.14159265358979323846);
     s += buf;
     if (r.given_facets) s += std::to_string(r.given_facets) + " facets kept their SRE surface\n";
-    if (outside) s += std::to_string(outside) + " regions not within the tolerance of any surface\n";
+    if (outside)
+        s += std::to_string(outside) + " regions not within the tolerance of any surface\n";
     std::snprintf(buf, sizeof buf, "seconds: curvature %.3f, segment %.3f, fit %.3f\n",
                   r.curvature_seconds, r.segment_seconds, r.fit_seconds);
     s += buf;

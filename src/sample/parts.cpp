@@ -8,6 +8,7 @@
 #include <BRepAlgoAPI_Fuse.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepFilletAPI_MakeChamfer.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
@@ -660,6 +661,112 @@ TopoDS_Shape build_enclosure(Dims& d) {
     return shell.Shape();
 }
 
+// Parts that stress segmentation (issue 7): a gentle fillet only a facet or two wide between two
+// planes, countersinks meeting their bores with no plane between, a shallow free-form face
+// next to a plane it almost continues, thin slots whose walls are one facet strip each.
+
+TopoDS_Shape build_fillet_wedge(Dims& d) {
+    const double L = d.length("block_length", 80), W = d.length("block_width", 50);
+    const double H = d.length("block_height", 30);
+    const double ridge = d.length("ridge_x", 45);
+    const double slope = d.angle_deg("roof_slope_deg", 25);
+    const double rr = d.length("ridge_fillet", 12);
+    const double rv = d.length("corner_fillet", 2);
+    // The profile in the XZ plane: a flat top up to the ridge, then a roof sloping down.
+    const double drop = (L - ridge) * std::tan(deg(slope));
+    BRepBuilderAPI_MakePolygon poly;
+    poly.Add(gp_Pnt(0, 0, 0));
+    poly.Add(gp_Pnt(L, 0, 0));
+    poly.Add(gp_Pnt(L, 0, H - drop));
+    poly.Add(gp_Pnt(ridge, 0, H));
+    poly.Add(gp_Pnt(0, 0, H));
+    poly.Close();
+    BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
+    if (!face.IsDone()) throw ModelError("wedge profile failed");
+    TopoDS_Shape part = BRepPrimAPI_MakePrism(face.Face(), gp_Vec(0, W, 0)).Shape();
+    part = fillet(part, rv, select_edges(part, [](const EdgeGeom& g) { return g.is_vertical(); }),
+                  "vertical corners");
+    return fillet(part, rr,
+                  select_edges(part,
+                               [&](const EdgeGeom& g) {
+                                   return g.along_y() && near(g.a.X(), ridge) && near(g.a.Z(), H);
+                               }),
+                  "ridge");
+}
+
+TopoDS_Shape build_countersink_bore(Dims& d) {
+    const double L = d.length("plate_length", 90), W = d.length("plate_width", 40);
+    const double T = d.length("plate_thickness", 12);
+    const double bore = d.length("bore_diameter", 8);
+    const double csk = d.length("countersink_diameter", 16);
+    TopoDS_Shape part = box(0, 0, 0, L, W, T);
+    // Three countersinks of 90, 82 and 120 degrees, each meeting its bore directly.
+    const double angles[3] = {d.angle_deg("countersink_a_deg", 90),
+                              d.angle_deg("countersink_b_deg", 82),
+                              d.angle_deg("countersink_c_deg", 120)};
+    for (int i = 0; i < 3; ++i) {
+        const double half = deg(0.5 * angles[i]);
+        const double rb = 0.5 * bore, rc = 0.5 * csk;
+        const double cone_depth = (rc - rb) / std::tan(half);
+        const gp_Ax2 frame(gp_Pnt(L * (i + 1) / 4.0, 0.5 * W, T), gp_Dir(0, 0, 1), gp_Dir(1, 0, 0));
+        const std::array<std::array<double, 2>, 6> rh{{{0, kOverrun},
+                                                       {rc + kOverrun * std::tan(half), kOverrun},
+                                                       {rc, 0},
+                                                       {rb, -cone_depth},
+                                                       {rb, -T - kOverrun},
+                                                       {0, -T - kOverrun}}};
+        part = cut(part, revolve_polygon(frame, rh), "countersunk bore");
+    }
+    return part;
+}
+
+TopoDS_Shape build_shallow_freeform(Dims& d) {
+    const double L = d.length("block_length", 100), W = d.length("block_width", 60);
+    const double H = d.length("block_height", 25);
+    const double x0 = d.length("flat_length", 45);
+    const double A = d.length("rise", 3);
+    // A surface that leaves the flat top at x0 with zero height and (nearly) zero slope and
+    // rises gently, with a slight wave across: a free-form face almost continuing the plane.
+    constexpr int kNu = 9, kNv = 7;
+    TColgp_Array2OfPnt pts(1, kNu, 1, kNv);
+    const double span = 1.2 * (L - x0);
+    for (int i = 1; i <= kNu; ++i) {
+        for (int j = 1; j <= kNv; ++j) {
+            const double u = (i - 1.0) / (kNu - 1), v = -0.15 + 1.3 * (j - 1.0) / (kNv - 1);
+            const double z = H + A * u * u * (1 + 0.3 * std::sin(kPi * v));
+            pts.SetValue(i, j, gp_Pnt(x0 + u * span, v * W, z));
+        }
+    }
+    GeomAPI_PointsToBSplineSurface approx;
+    approx.Interpolate(pts);
+    if (!approx.IsDone()) throw ModelError("shallow surface interpolation failed");
+    BRepBuilderAPI_MakeFace top(approx.Surface(), 1e-6);
+    if (!top.IsDone()) throw ModelError("shallow face failed");
+    const TopoDS_Shape slab =
+        BRepPrimAPI_MakePrism(top.Face(), gp_Vec(0, 0, -(H + 2 * A + 10))).Shape();
+    const TopoDS_Shape rising = common(box(x0, 0, 0, L, W, H + 2 * A + 5), slab, "rising part");
+    return unify(fuse(box(0, 0, 0, x0, W, H), rising, "shallow block"));
+}
+
+TopoDS_Shape build_thin_slot(Dims& d) {
+    const double L = d.length("plate_length", 80), W = d.length("plate_width", 40);
+    const double T = d.length("plate_thickness", 12);
+    const double sw = d.length("slot_width", 1.2), sd = d.length("slot_depth", 6);
+    const double sl = d.length("slot_length", 50);
+    const double tw = d.length("through_slot_width", 2.5), tl = d.length("through_slot_length", 30);
+    TopoDS_Shape part = box(0, 0, 0, L, W, T);
+    // A saw cut: square ends, flat bottom, walls one facet strip each.
+    const double x0 = 0.5 * (L - sl), y0 = 0.3 * W;
+    part =
+        cut(part, box(x0, y0 - 0.5 * sw, T - sd, x0 + sl, y0 + 0.5 * sw, T + kOverrun), "saw cut");
+    // A narrow through slot with round ends.
+    part = cut(
+        part,
+        stadium_prism(0.5 * L, 0.72 * W, 0.5 * (tl - tw), 0.5 * tw, -kOverrun, T + 2 * kOverrun),
+        "narrow slot");
+    return part;
+}
+
 constexpr PartEntry kParts[] = {
     {{"pocket_block",
       "block with a rectangular pocket: corner radii, floor fillets (tori at the corners), "
@@ -689,6 +796,16 @@ constexpr PartEntry kParts[] = {
     {{"flange", "flange with a hub, chamfers, a fillet, a bore and a bolt circle"}, build_flange},
     {{"keyway_shaft", "shaft with chamfered ends and a milled keyway"}, build_keyway_shaft},
     {{"enclosure", "shelled box (open top) with rounded vertical corners"}, build_enclosure},
+    {{"fillet_wedge",
+      "block with a flat top and a sloping roof joined by a gentle fillet a facet or two wide, "
+      "filleted vertical corners"},
+     build_fillet_wedge},
+    {{"countersink_bore", "plate with three countersinks (90, 82, 120 deg) meeting their bores"},
+     build_countersink_bore},
+    {{"shallow_freeform", "block whose flat top continues into a shallow free-form B-spline face"},
+     build_shallow_freeform},
+    {{"thin_slot", "plate with a 1.2 mm saw cut and a narrow round-ended through slot"},
+     build_thin_slot},
 };
 
 }  // namespace

@@ -72,6 +72,8 @@ constexpr std::size_t kDominantRatio = 4;
 /// Growing regions are refitted each time they double, up to this many facets: by then the
 /// surface is known far better than the tolerance, and the final fit uses every facet anyway.
 constexpr std::size_t kMaxGrowthRefit = 1u << 14;
+/// From this many facets a growing region's kind is settled (see settled()).
+constexpr std::size_t kSettledFacets = 4096;
 /// See firm_plane().
 constexpr std::size_t kFirmPlaneFacets = 8;
 constexpr double kFirmPlaneShare = 0.25;
@@ -363,6 +365,13 @@ bool firm_plane(const Context& c, const Draft& d) {
     return true;
 }
 
+/// The kind of a region large enough for it to be settled (tried first when refitting, see
+/// fit_faces()); none for a smaller one, whose kind is chosen afresh, simplest first.
+std::optional<FitKind> settled(const Draft& d) {
+    if (d.faces.size() < kSettledFacets) return std::nullopt;
+    return d.surface.kind;
+}
+
 /// Grows the regions of one patch (see the header). `owner` and `mark` are per-face arrays
 /// shared by all patches (patches are disjoint, so threads never touch the same entry).
 std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patch,
@@ -445,7 +454,7 @@ std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patc
                 if (d.faces.size() >= 2 * last_fit && d.faces.size() >= 16 &&
                     d.faces.size() <= kMaxGrowthRefit) {
                     // Refit as the region doubles: noise averages out, the kind may change.
-                    if (auto r = fit_faces(c, d.faces, kRevolutionFitKinds, d.surface.kind))
+                    if (auto r = fit_faces(c, d.faces, kRevolutionFitKinds, settled(d)))
                         d.surface = r->surface;
                     last_fit = d.faces.size();
                 }
@@ -463,7 +472,7 @@ std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patc
                 d.faces.size() >= kDominantRatio * rejected.size() || firm_plane(c, d)
                     ? fit_kind_bit(d.surface.kind)
                     : kRevolutionFitKinds;
-            auto r = fit_faces(c, trial, kinds, d.surface.kind);
+            auto r = fit_faces(c, trial, kinds, settled(d));
             if (!r) {
                 // The second ring: unassigned neighbours of the first, not yet queued.
                 const std::size_t first = trial.size();
@@ -474,7 +483,7 @@ std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patc
                         trial.push_back(g);
                     }
                 }
-                if (trial.size() > first) r = fit_faces(c, trial, kinds, d.surface.kind);
+                if (trial.size() > first) r = fit_faces(c, trial, kinds, settled(d));
                 if (r) {
                     rejected.assign(trial.begin() + static_cast<std::ptrdiff_t>(d.faces.size()),
                                     trial.end());
