@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "ncrev/curvature.h"
@@ -260,6 +261,96 @@ TEST(CliCurvature, BadInputAndUsageErrorsWriteNothing) {
     const CliRun ok = run("curvature " + in.string() + " -o " + out.string() + " --json -q");
     ASSERT_EQ(ok.code, 0) << ok.err;
     EXPECT_EQ(nlohmann::json::parse(ok.out)["curvature"]["high_points"], 8);
+}
+
+}  // namespace
+}  // namespace ncrev
+
+namespace ncrev {
+namespace {
+
+TEST(CliSegment, WritesRegionsLabelsAndOneJsonDocument) {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("ncrev_cli_segment." + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    ASSERT_EQ(run("sample slot_plate -q -o " + dir.string()).code, 0);
+    const auto stl = dir / "slot_plate" / "slot_plate.stl";
+    const auto ply = dir / "regions.ply", labels = dir / "regions.labels";
+    const CliRun r = run("segment " + stl.string() + " -o " + ply.string() + " --labels " +
+                         labels.string() + " --json -q");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["segment"]["method"], "facets");
+    EXPECT_GT(j["segment"]["tolerance"].get<double>(), 0.0);
+    const auto& regions = j["regions"];
+    ASSERT_EQ(regions.size(), 15u);  // the slot plate's faces
+    std::uint64_t facets = 0;
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+        const auto& g = regions[i];
+        EXPECT_EQ(g["id"], static_cast<int>(i));
+        facets += g["facets"].get<std::uint64_t>();
+        const std::string kind = g["kind"];
+        if (kind == "plane") {
+            EXPECT_EQ(g["params"]["point"].size(), 3u);
+            EXPECT_EQ(g["params"]["normal"].size(), 3u);
+        } else {
+            ASSERT_EQ(kind, "cylinder");
+            EXPECT_EQ(g["params"]["axis_point"].size(), 3u);
+            EXPECT_EQ(g["params"]["axis_dir"].size(), 3u);
+            EXPECT_GT(g["params"]["radius"].get<double>(), 0.0);
+        }
+        EXPECT_GT(g["area"].get<double>(), 0.0);
+        EXPECT_LE(g["max"].get<double>(), j["segment"]["tolerance"].get<double>());
+    }
+    EXPECT_EQ(facets, j["mesh"]["facets"].get<std::uint64_t>());
+    // One label per input facet; the true labels and ours describe the same partition.
+    std::ifstream lf(labels), tf(dir / "slot_plate" / "slot_plate.labels");
+    std::vector<int> ours, truth;
+    for (int x; lf >> x;) ours.push_back(x);
+    for (int x; tf >> x;) truth.push_back(x);
+    ASSERT_EQ(ours.size(), truth.size());
+    std::map<int, int> ours_to_truth;
+    for (std::size_t i = 0; i < ours.size(); ++i) {
+        const auto [it, fresh] = ours_to_truth.emplace(ours[i], truth[i]);
+        EXPECT_EQ(it->second, truth[i]) << "facet " << i;
+    }
+    std::ifstream pf(ply, std::ios::binary);
+    std::string head(400, '\0');
+    pf.read(head.data(), 400);
+    EXPECT_NE(head.find("property int region\nproperty uchar red"), std::string::npos);
+    // The paper method from the CLI, and an SRE input keeping its surfaces.
+    const CliRun paper =
+        run("segment " + stl.string() + " -o " + ply.string() + " --method paper --json -q");
+    ASSERT_EQ(paper.code, 0) << paper.err;
+    EXPECT_EQ(nlohmann::json::parse(paper.out)["segment"]["method"], "paper");
+    const CliRun sre = run("segment " + (dir / "slot_plate" / "slot_plate.sre").string() + " -o " +
+                           ply.string() + " --json -q");
+    ASSERT_EQ(sre.code, 0) << sre.err;
+    const auto js = nlohmann::json::parse(sre.out);
+    EXPECT_EQ(js["segment"]["given_facets"], js["mesh"]["facets"]);
+    std::filesystem::remove_all(dir);
+}
+
+TEST(CliSegment, RefusesToOverwriteItsInputAndReportsBadInput) {
+    const auto m = test::icosphere(5.0, 2);
+    const auto in =
+        write_temp("ncrev_cli_segment_in.stl", encode_stl_binary(m.points, m.triangles));
+    const auto before = std::filesystem::file_size(in);
+    EXPECT_EQ(run("segment " + in.string() + " -o " + in.string() + " -q").code, 1);
+    EXPECT_EQ(
+        run("segment " + in.string() + " -o /tmp/ncrev_x.ply --labels " + in.string() + " -q").code,
+        1);
+    EXPECT_EQ(std::filesystem::file_size(in), before);
+    const auto bad =
+        write_temp("ncrev_cli_segment_bad.stl", {std::byte{'s'}, std::byte{'o'}, std::byte{'l'}});
+    const auto out = std::filesystem::temp_directory_path() / "ncrev_cli_segment_bad.ply";
+    std::filesystem::remove(out);
+    const CliRun r = run("segment " + bad.string() + " -o " + out.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(r.out.empty());
+    EXPECT_NE(r.err.find("ncrev_cli_segment_bad.stl"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out));
+    EXPECT_EQ(run("segment " + in.string() + " -o " + out.string() + " --method magic").code, 1);
 }
 
 }  // namespace

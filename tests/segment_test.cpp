@@ -8,7 +8,9 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <map>
+#include <numbers>
 #include <string>
 
 #include "ncrev/mesh.h"
@@ -108,6 +110,141 @@ Score run(const Case& c, SegmentMethod method) {
     Score s = score(c.mesh, r.value(), c.part);
     s.seconds = secs;
     return s;
+}
+
+// The targets of issue 7 on every sample part, fine and coarse, with the default method.
+TEST(Segment, SamplePartsMeetTheTargets) {
+    double iou = 0, area = 0, kind_area = 0;
+    int cases = 0, count_right = 0;
+    for (const SamplePartInfo& info : sample_parts()) {
+        for (const double d : {kFine, kCoarse}) {
+            const Case c = make_case(info.name, d);
+            const Score s = run(c, SegmentMethod::kFacets);
+            EXPECT_GE(s.iou, 0.95) << info.name << " " << d << ": " << s.worst;
+            iou += s.iou;
+            area += s.area;
+            kind_area += s.kind_right * s.area;
+            count_right += s.regions == s.faces;
+            ++cases;
+        }
+    }
+    EXPECT_GE(iou / cases, 0.98);
+    EXPECT_GE(count_right, 0.9 * cases) << count_right << " of " << cases;
+    EXPECT_GE(kind_area / area, 0.99);
+}
+
+// The paper's method is complete: on parts whose faces have vertices of their own type (planes
+// between sharp edges, strips of cylinders) it finds every face; elsewhere every facet still
+// gets a region and every region a surface.
+TEST(Segment, PaperMethodFindsTheFacesOfPrismaticParts) {
+    for (const char* name : {"l_bracket", "slot_plate", "keyway_shaft", "thin_slot"}) {
+        const Case c = make_case(name, kFine);
+        const Score s = run(c, SegmentMethod::kPaper);
+        EXPECT_GE(s.iou, 0.99) << name << ": " << s.worst;
+        EXPECT_EQ(s.regions, s.faces) << name;
+    }
+    const Case c = make_case("flange", kFine);
+    SegmentOptions o;
+    o.method = SegmentMethod::kPaper;
+    const SegmentResult r = segment(c.mesh, o).value();
+    EXPECT_GT(r.curvature_seconds, 0.0);
+    for (std::size_t f = 0; f < c.mesh.num_faces(); ++f) {
+        const std::int32_t g = r.region[FaceId(static_cast<std::uint32_t>(f))];
+        ASSERT_GE(g, 0);
+        ASSERT_LT(static_cast<std::size_t>(g), r.regions.size());
+    }
+    for (const Region& g : r.regions) EXPECT_GT(g.facets, 0u);
+}
+
+// SRE input: the given surfaces are the regions; only the free-form face (index -1) is
+// segmented, and comes back as one B-spline.
+TEST(Segment, KeepsTheSreSurfacesAndSegmentsTheRest) {
+    const Case c = make_case("freeform_die", kFine);
+    SegmentOptions o;
+    o.surfaces = c.part.mesh.surfaces;
+    const SegmentResult r = segment(c.mesh, o).value();
+    std::uint64_t given = 0;
+    for (const std::int32_t sidx : c.mesh.surfaces()) given += sidx >= 0;
+    EXPECT_EQ(r.given_facets, given);
+    EXPECT_GT(given, 0u);
+    EXPECT_LT(given, c.mesh.num_faces());
+    ASSERT_EQ(r.regions.size(), c.part.faces.size());
+    const Score s = score(c.mesh, r, c.part);
+    EXPECT_GT(s.iou, 1 - 1e-9);
+    int bsplines = 0;
+    for (const Region& g : r.regions) {
+        if (g.surface_index >= 0) {
+            EXPECT_TRUE(g.within_tolerance) << g.id;
+            EXPECT_LT(g.fit.max, 1e-3) << g.id;
+        } else {
+            bsplines += g.fit.surface.kind == FitKind::kBSpline;
+        }
+    }
+    EXPECT_EQ(bsplines, 1);
+    // Without the indices, the same mesh is segmented from its shape alone.
+    o.use_surface_indices = false;
+    EXPECT_EQ(segment(c.mesh, o).value().given_facets, 0u);
+}
+
+TEST(Segment, SameResultWhateverTheThreadCount) {
+    const Case c = make_case("flange", kCoarse);
+    const SegmentResult many = segment(c.mesh).value();
+    SegmentResult one;
+    {
+        tbb::global_control g(tbb::global_control::max_allowed_parallelism, 1);
+        one = segment(c.mesh).value();
+    }
+    EXPECT_EQ(many.region.data(), one.region.data());
+    ASSERT_EQ(many.regions.size(), one.regions.size());
+    for (std::size_t i = 0; i < one.regions.size(); ++i) {
+        EXPECT_EQ(many.regions[i].fit.surface.kind, one.regions[i].fit.surface.kind);
+        EXPECT_EQ(many.regions[i].fit.rms, one.regions[i].fit.rms);
+        EXPECT_EQ(many.regions[i].fit.surface.radius, one.regions[i].fit.surface.radius);
+    }
+}
+
+// Regions carry exact surfaces: the fitted radii of the drilled plate's holes are the drawn ones.
+TEST(Segment, RegionsCarryTheirSurfaces) {
+    const Case c = make_case("counterbore_countersink", kFine);
+    const SegmentResult r = segment(c.mesh).value();
+    std::map<std::string, int> kinds;
+    for (const Region& g : r.regions) {
+        EXPECT_TRUE(g.within_tolerance) << g.id;
+        ++kinds[to_string(g.fit.surface.kind)];
+        if (g.fit.surface.kind == FitKind::kCone) {
+            EXPECT_NEAR(g.fit.surface.angle, std::numbers::pi / 4, 1e-6);
+        }
+    }
+    std::map<std::string, int> want;
+    for (const SampleFace& f : c.part.faces) ++want[truth_kind(f.kind)];
+    EXPECT_EQ(kinds, want);
+}
+
+TEST(Segment, LabelsFollowTheInputFacets) {
+    // Two triangles of a square, a degenerate one between them (removed by healing).
+    TriangleSoup soup;
+    soup.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    soup.triangles = {{0, 1, 2}, {0, 1, 1}, {0, 2, 3}};
+    const BuildResult b = build_mesh(soup).value();
+    const SegmentResult r = segment(b.mesh).value();
+    ASSERT_EQ(r.regions.size(), 1u);
+    EXPECT_EQ(r.regions[0].fit.surface.kind, FitKind::kPlane);
+    EXPECT_EQ(input_labels(b.mesh, r, 3), (std::vector<std::int32_t>{0, -1, 0}));
+    const std::vector<std::byte> ply = encode_segments_ply(b.mesh, r);
+    const std::string text(reinterpret_cast<const char*>(ply.data()), ply.size());
+    EXPECT_NE(text.find("element face 2\nproperty list uchar int vertex_indices\nproperty int "
+                        "region\nproperty uchar red\nproperty uchar green\nproperty uchar blue"),
+              std::string::npos)
+        << text.substr(0, 300);
+}
+
+TEST(Segment, RejectsNonFiniteOptions) {
+    const Case c = make_case("slot_plate", kFine);
+    SegmentOptions o;
+    o.tolerance = std::numeric_limits<double>::quiet_NaN();
+    const Result<SegmentResult> r = segment(c.mesh, o);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().code, ErrorCode::kBadValue);
 }
 
 // The table of docs/segmentation.md:

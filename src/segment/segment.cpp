@@ -58,10 +58,6 @@ constexpr double kSagFactor = 2;
 /// Dihedral angle (rad) below which an edge is flat for the sag estimate: far above float32
 /// rounding of the normals of facets a thousandth of the part wide.
 constexpr double kFlatDihedral = 1e-3;
-/// As fit_simplest(): a richer kind replaces a simpler passing one only when its RMS is lower
-/// by more than 10 % plus 2 % of the tolerance.
-constexpr double kSignificantRms = 1.1;
-constexpr double kRmsFloor = 0.02;
 /// The share of a region's area whose facet normals may disagree with its surface.
 constexpr double kNormalOutlierArea = 0.02;
 /// A plane with at least this share of the area of the regions smoothly joined to it is a face,
@@ -76,7 +72,9 @@ constexpr std::size_t kMaxGrowthRefit = 1u << 14;
 constexpr std::size_t kSettledFacets = 4096;
 /// See firm_plane().
 constexpr std::size_t kFirmPlaneFacets = 8;
-constexpr double kFirmPlaneShare = 0.25;
+constexpr double kFirmPlaneShare = 0.01;
+/// Facets of each region that order the merge queue (see unlikeness()).
+constexpr std::size_t kLikenessSamples = 1024;
 /// Regions of at most this many facets are dissolved into their neighbours when these fit them.
 constexpr std::size_t kSmallRegion = 8;
 /// Rounds of border refinement (each moves facets one row at most).
@@ -218,10 +216,46 @@ double estimate_sag(const Context& c) {
     return std::max(c.tol, kSagFactor * *q);
 }
 
-/// The surface's unit normal near `p` (a facet centroid), found from the closest points of two
-/// probes on either side along the facet normal `hint`: works for every kind, the B-spline too.
+/// The surface's unit normal near `p` (a facet centroid): in closed form for plane to torus,
+/// otherwise from the closest points of two probes on either side along the facet normal
+/// `hint` (the sheared kinds, the B-spline).
 Vec3 surface_normal(const Surface& s, Vec3 p, Vec3 hint, double h) {
-    if (s.kind == FitKind::kPlane) return s.axis;
+    // The surfaces of revolution have their normal in closed form (up to sign, which the
+    // callers ignore); only off their axis, which a facet of the surface never touches.
+    const auto radial = [&](Vec3& dir) {
+        const Vec3 q = p - s.point;
+        const Vec3 r = q - s.axis * dot(q, s.axis);
+        const double l = norm(r);
+        if (!(l > 0)) return false;
+        dir = r / l;
+        return true;
+    };
+    Vec3 rho;
+    switch (s.kind) {
+        case FitKind::kPlane:
+            return s.axis;
+        case FitKind::kSphere: {
+            const Vec3 q = p - s.point;
+            const double l = norm(q);
+            if (l > 0) return q / l;
+            break;
+        }
+        case FitKind::kCylinder:
+            if (radial(rho)) return rho;
+            break;
+        case FitKind::kCone:
+            if (radial(rho)) return rho * std::cos(s.angle) - s.axis * std::sin(s.angle);
+            break;
+        case FitKind::kTorus:
+            if (radial(rho)) {
+                const Vec3 q = p - (s.point + rho * s.radius);
+                const double l = norm(q);
+                if (l > 0) return q / l;
+            }
+            break;
+        default:
+            break;
+    }
     Vec3 best = hint;
     double best_len = 0;
     for (const double sign : {1.0, -1.0}) {
@@ -355,7 +389,9 @@ std::vector<std::vector<std::uint32_t>> smooth_patches(const Context& c,
 }
 
 /// A region that is surely a plane: at least kFirmPlaneFacets facets, every vertex within a
-/// kFirmPlaneShare of the tolerance of its plane.
+/// kFirmPlaneShare of the tolerance of its plane (a machined plane's vertices lie on it to
+/// rounding; a patch of a finely tessellated torus is flat within a quarter of the tolerance
+/// over many facets, and must stay free to become the torus).
 bool firm_plane(const Context& c, const Draft& d) {
     if (d.surface.kind != FitKind::kPlane || d.faces.size() < kFirmPlaneFacets) return false;
     for (const std::uint32_t f : d.faces)
@@ -465,13 +501,11 @@ std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patc
             if (rejected.empty()) break;
             std::vector<std::uint32_t> trial = d.faces;
             trial.insert(trial.end(), rejected.begin(), rejected.end());
-            // A region much larger than the ring keeps its kind (as in merge_regions()); so
-            // does a plane of some size that holds its facets well within the tolerance: a
-            // flat torus would take in the plane and half the fillet beside it.
+            // A firm plane keeps its kind: a flat torus would take in the plane and half the
+            // fillet beside it. Curved regions may change kind however large (a patch of a
+            // fine torus grows as a cylinder until the torus leaves it by the tolerance).
             const FitKindSet kinds =
-                d.faces.size() >= kDominantRatio * rejected.size() || firm_plane(c, d)
-                    ? fit_kind_bit(d.surface.kind)
-                    : kRevolutionFitKinds;
+                firm_plane(c, d) ? fit_kind_bit(d.surface.kind) : kRevolutionFitKinds;
             auto r = fit_faces(c, trial, kinds, settled(d));
             if (!r) {
                 // The second ring: unassigned neighbours of the first, not yet queued.
@@ -540,11 +574,13 @@ std::vector<std::uint32_t> region_of_faces(const Mesh& m, const std::vector<Draf
 /// How alike two regions are (smaller: more alike): the largest distance of one's vertices to
 /// the other's surface, the smaller of the two ways.
 double unlikeness(const Context& c, const Draft& a, const Draft& b) {
+    // At most kLikenessSamples facets of each, evenly strided: an order, not a test.
     const auto worst = [&](const Draft& from, const Surface& to) {
         double w = 0;
-        for (const std::uint32_t f : from.faces)
+        const std::size_t step = std::max<std::size_t>(1, from.faces.size() / kLikenessSamples);
+        for (std::size_t k = 0; k < from.faces.size(); k += step)
             for (int i = 0; i < 3; ++i)
-                w = std::max(w, distance(to, c.m.position(c.m.vertex(fid(f), i))));
+                w = std::max(w, distance(to, c.m.position(c.m.vertex(fid(from.faces[k]), i))));
         return w;
     };
     return std::min(worst(a, b.surface), worst(b, a.surface));
@@ -787,24 +823,17 @@ std::uint64_t refine_borders(Context& c, std::vector<Draft>& drafts) {
     return moved;
 }
 
-/// The simplest kind in kKindOrder within the tolerance whose facets are its chords, unless a
-/// later kind that also passes has a clearly lower RMS (as fit_simplest(): a narrow strip of a
-/// cone fits a cylinder within a loose tolerance, but worse). `fallback` when none passes.
+/// The first kind in kKindOrder within the tolerance whose facets are its chords; `fallback`
+/// when none is. No RMS contest between passing kinds (fit_simplest() has one): it turns a
+/// plane that took in a facet of the fillet beside it into a torus.
 FitResult select_kind(const Context& c, const FitInput& in, std::span<const std::uint32_t> faces,
                       const FitResult& fallback) {
-    std::vector<FitResult> passing;
     for (const FitKind kind : kKindOrder) {
         if (in.points.size() < kMinVertices[static_cast<int>(kind)]) continue;
         FitResult r = fit(kind, in);
-        if (r.ok && r.max <= c.tol && chords_agree(c, r.surface, faces))
-            passing.push_back(std::move(r));
+        if (r.ok && r.max <= c.tol && chords_agree(c, r.surface, faces)) return r;
     }
-    if (passing.empty()) return fallback;
-    double best_rms = kInf;
-    for (const FitResult& r : passing) best_rms = std::min(best_rms, r.rms);
-    for (const FitResult& r : passing)
-        if (r.rms <= kSignificantRms * best_rms + kRmsFloor * c.tol) return r;
-    return passing.front();
+    return fallback;
 }
 
 /// The final fit of a region: the simplest kind within the tolerance (method.md Step 4) among
@@ -838,11 +867,12 @@ Region final_region(Context& c, const Draft& d, std::span<const SurfaceRecord> r
         out.fit = fit_bspline(FitInput{ps.points, ps.normals, {}}, c.sag);  // as merge_freeform()
         if (!out.fit.ok) out.fit = residuals(d.surface);
     } else {
-        // The kind the region was grown and merged with, refitted, when it still holds: the
-        // RMS comparison of select_kind() would turn a plane that took in a facet of the
-        // fillet beside it into a torus.
+        // A settled region's own kind first (no four failed fits to a million facets of a
+        // torus); otherwise the simplest kind afresh (a band of a cone grown from a few
+        // facets that a sphere fitted is a cone).
         out.fit = residuals(d.surface);
-        FitResult same = fit(d.surface.kind, in);
+        FitResult same;
+        if (settled(d)) same = fit(d.surface.kind, in);
         if (same.ok && same.max <= c.tol && chords_agree(c, same.surface, d.faces))
             out.fit = std::move(same);
         else
