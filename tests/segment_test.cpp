@@ -291,7 +291,10 @@ TEST(SegmentStudy, DISABLED_Table) {
 }  // namespace
 }  // namespace ncrev
 namespace ncrev {
-TEST(SegmentStudy, DISABLED_Debug) {
+// One part's regions against its true faces, and each small region's fit to its neighbours,
+// for looking into a part of the table: PART=flange [COARSE=1] build/bin/ncrev_tests
+// --gtest_also_run_disabled_tests --gtest_filter='SegmentStudy.*Regions'
+TEST(SegmentStudy, DISABLED_Regions) {
     const char* name = std::getenv("PART") ? std::getenv("PART") : "l_bracket";
     const Case c = make_case(name, std::getenv("COARSE") ? kCoarse : kFine);
     SegmentOptions o;
@@ -336,42 +339,5 @@ TEST(SegmentStudy, DISABLED_Debug) {
                     g.fit.surface.axis.y, g.fit.surface.axis.z, g.fit.max, (long long)k.second,
                     c.part.faces[static_cast<std::size_t>(k.second)].kind.c_str(), n);
     }
-}
-}  // namespace ncrev
-namespace ncrev {
-TEST(SegmentStudy, DISABLED_FreeformFace) {
-    const Case c = make_case("freeform_die", std::getenv("COARSE") ? kCoarse : kFine);
-    std::vector<Vec3> pts;
-    std::vector<std::uint8_t> seen(c.mesh.num_vertices(), 0);
-    for (std::size_t f = 0; f < c.mesh.num_faces(); ++f) {
-        if (c.part.faces[static_cast<std::size_t>(c.mesh.cuts()[f])].kind == "plane") continue;
-        for (int k = 0; k < 3; ++k) {
-            const VertexId v = c.mesh.vertex(FaceId(static_cast<std::uint32_t>(f)), k);
-            if (!seen[v.idx()]) seen[v.idx()] = 1, pts.push_back(c.mesh.position(v));
-        }
-    }
-    const double tol = default_segment_tolerance(c.mesh);
-    const FitResult r = fit_bspline(FitInput{pts, {}, {}}, tol);
-    std::printf("points %zu tol %g ok %d max %g rms %g net %d x %d %s\n", pts.size(), tol, r.ok,
-                r.max, r.rms, r.ok ? r.surface.bspline->num_u : 0,
-                r.ok ? r.surface.bspline->num_v : 0, r.failure.c_str());
-}
-}  // namespace ncrev
-namespace ncrev {
-TEST(SegmentStudy, DISABLED_FaceDihedrals) {
-    const char* name = std::getenv("PART") ? std::getenv("PART") : "freeform_die";
-    const Case c = make_case(name, std::getenv("COARSE") ? kCoarse : kFine);
-    std::map<std::int64_t, double> worst;
-    for (std::uint32_t h = 0; h < c.mesh.num_halfedges(); ++h) {
-        const HalfedgeId t = c.mesh.twin(HalfedgeId(h));
-        if (!t.is_valid()) continue;
-        const auto a = c.mesh.cuts()[Mesh::face(HalfedgeId(h)).idx()],
-                   b = c.mesh.cuts()[Mesh::face(t).idx()];
-        if (a != b) continue;
-        worst[a] = std::max(worst[a], std::abs(dihedral_angle(c.mesh, HalfedgeId(h))) * 57.2958);
-    }
-    for (const auto& [f, w] : worst)
-        std::printf("face %lld %s max dihedral %.1f deg\n", (long long)f,
-                    c.part.faces[static_cast<std::size_t>(f)].kind.c_str(), w);
 }
 }  // namespace ncrev
