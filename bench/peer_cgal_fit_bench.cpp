@@ -3,9 +3,6 @@
 // with normals: detection restricted to the one shape type, on the same 120 degree patches as
 // BM_Fit (fit_bench.cpp), with CGAL's epsilon set to 6 sigma of the noise. It detects and fits
 // (least squares on the inliers); ncrev's fit() only fits a region already known.
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Shape_detection/Efficient_RANSAC.h>
-
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -13,17 +10,12 @@
 #include <vector>
 
 #include "bench_common.h"
+#include "peer_cgal_ransac.h"
 
 namespace ncrev::bench {
 namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Pwn = std::pair<K::Point_3, K::Vector_3>;
-using Pwns = std::vector<Pwn>;
-using Traits =
-    CGAL::Shape_detection::Efficient_RANSAC_traits<K, Pwns, CGAL::First_of_pair_property_map<Pwn>,
-                                                   CGAL::Second_of_pair_property_map<Pwn>>;
-using Ransac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
+using namespace cgal_ransac;
 
 /// The cylinder (kind 0) or torus (kind 1) patch of fit_bench.cpp, as CGAL points.
 Pwns patch(int kind, std::size_t count) {

@@ -4,9 +4,6 @@
 // meshes as segment_bench.cpp. Its epsilon is ncrev's derived tolerance (2e-4 x the diagonal),
 // cluster epsilon three times the mean edge length, at least 0.5 % of the points per shape.
 // It labels points, not facets, and leaves unassigned points; ncrev labels every facet.
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Shape_detection/Efficient_RANSAC.h>
-
 #include <map>
 #include <utility>
 #include <vector>
@@ -14,17 +11,12 @@
 #include "bench_common.h"
 #include "ncrev/mesh.h"
 #include "ncrev/segment.h"
+#include "peer_cgal_ransac.h"
 
 namespace ncrev::bench {
 namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Pwn = std::pair<K::Point_3, K::Vector_3>;
-using Pwns = std::vector<Pwn>;
-using Traits =
-    CGAL::Shape_detection::Efficient_RANSAC_traits<K, Pwns, CGAL::First_of_pair_property_map<Pwn>,
-                                                   CGAL::Second_of_pair_property_map<Pwn>>;
-using Ransac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
+using namespace cgal_ransac;
 
 struct Input {
     Pwns points;

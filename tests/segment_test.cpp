@@ -341,3 +341,55 @@ TEST(SegmentStudy, DISABLED_Regions) {
     }
 }
 }  // namespace ncrev
+
+namespace ncrev {
+namespace {
+
+// Border chains and corners of the true labelling of the drilled plate: the box's 12 edges
+// between its 8 corners, and one closed loop per rim: 4 through holes x 2 ends, 3 blind holes'
+// entries and their cylinder-cone rims.
+TEST(SegmentBorders, ChainsAndCornersOfTheDrilledPlate) {
+    const Case c = make_case("drilled_plate", kFine);
+    FaceMap<std::int32_t> truth(c.mesh.num_faces());
+    for (std::size_t f = 0; f < c.mesh.num_faces(); ++f)
+        truth[FaceId(static_cast<std::uint32_t>(f))] = static_cast<std::int32_t>(c.mesh.cuts()[f]);
+    const RegionBorders b = region_borders(c.mesh, truth);
+    EXPECT_EQ(b.corners.size(), 8u);
+    std::size_t closed = 0;
+    std::size_t edges = 0;
+    for (const BorderChain& ch : b.chains) {
+        EXPECT_GT(ch.left, ch.right);
+        EXPECT_GE(ch.vertices.size(), 2u);
+        closed += ch.closed;
+        edges += ch.vertices.size() - 1;
+        if (ch.closed) {
+            EXPECT_EQ(ch.vertices.front(), ch.vertices.back());
+        } else {
+            EXPECT_TRUE(
+                std::binary_search(b.corners.begin(), b.corners.end(), ch.vertices.front()));
+            EXPECT_TRUE(std::binary_search(b.corners.begin(), b.corners.end(), ch.vertices.back()));
+        }
+        // Consecutive vertices are joined by a mesh edge with `left` on its left.
+        for (std::size_t i = 0; i + 1 < ch.vertices.size(); ++i) {
+            bool found = false;
+            c.mesh.for_each_outgoing(ch.vertices[i], [&](HalfedgeId h) {
+                found = found || (c.mesh.target(h) == ch.vertices[i + 1] &&
+                                  truth[Mesh::face(h)] == ch.left &&
+                                  truth[Mesh::face(c.mesh.twin(h))] == ch.right);
+            });
+            ASSERT_TRUE(found) << "chain between " << ch.left << " and " << ch.right;
+        }
+    }
+    EXPECT_EQ(b.chains.size(), 26u);
+    EXPECT_EQ(closed, 14u);
+    // Every border edge once.
+    std::size_t border_edges = 0;
+    for (std::uint32_t h = 0; h < c.mesh.num_halfedges(); ++h) {
+        const HalfedgeId t = c.mesh.twin(HalfedgeId(h));
+        border_edges += t.idx() > h && truth[Mesh::face(HalfedgeId(h))] != truth[Mesh::face(t)];
+    }
+    EXPECT_EQ(edges, border_edges);
+}
+
+}  // namespace
+}  // namespace ncrev

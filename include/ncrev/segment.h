@@ -121,4 +121,29 @@ std::vector<std::int32_t> input_labels(const Mesh& mesh, const SegmentResult& re
 /// color per region.
 std::vector<std::byte> encode_segments_ply(const Mesh& mesh, const SegmentResult& result);
 
+/// A border between two regions (or a region and the mesh boundary): a chain of mesh edges
+/// from corner to corner, or a closed loop with no corner on it.
+struct BorderChain {
+    /// The regions on either side, left > right: `left` lies to the left walking along
+    /// `vertices` seen from outside; `right` is -1 for the mesh boundary.
+    std::int32_t left = -1, right = -1;
+    /// The chain's vertices in order; a closed loop repeats its first vertex at the end.
+    std::vector<VertexId> vertices;
+    bool closed = false;
+};
+
+/// The borders of a labelling: every mesh edge between two regions (or on the boundary) lies
+/// on exactly one chain; chains end at corners — vertices where three or more regions meet,
+/// counting the mesh boundary as one — and a chain between the same two regions that meets no
+/// corner is a closed loop (a hole's rim). What method.md Step 2b calls border chains and
+/// corners: the edges and vertices of the B-rep to come.
+struct RegionBorders {
+    std::vector<BorderChain> chains;
+    std::vector<VertexId> corners;  ///< ascending
+};
+
+/// The borders of `face_region` (one region id >= 0 per face, e.g. SegmentResult::region).
+/// Deterministic: chains start at the lowest corner, or the lowest vertex of a loop.
+RegionBorders region_borders(const Mesh& mesh, const FaceMap<std::int32_t>& face_region);
+
 }  // namespace ncrev

@@ -251,6 +251,21 @@ TopoDS_Shape drill_tool(double x, double y, double top, double d, double depth) 
     return revolve_polygon(frame, rh);
 }
 
+/// A countersunk through hole entering at (x, y, top) along -Z: the cone from radius rk at the
+/// entry (its radius shrinks by `t` per unit depth) straight into the bore of radius rs, through
+/// a plate of thickness `depth`; the tool rises kOverrun above the entry.
+TopoDS_Shape countersink_tool(double x, double y, double top, double rk, double rs, double t,
+                              double depth) {
+    const gp_Ax2 frame(gp_Pnt(x, y, top), gp_Dir(0, 0, 1), gp_Dir(1, 0, 0));
+    const double cone_depth = (rk - rs) / t;
+    const std::array<std::array<double, 2>, 5> rh{{{0, kOverrun},
+                                                   {rk + kOverrun * t, kOverrun},
+                                                   {rs, -cone_depth},
+                                                   {rs, -depth - kOverrun},
+                                                   {0, -depth - kOverrun}}};
+    return revolve_polygon(frame, rh);
+}
+
 /// A straight through hole along Z from below z0 to above z1.
 TopoDS_Shape through_tool(double x, double y, double z0, double z1, double d) {
     BRepPrimAPI_MakeCylinder mk(gp_Ax2(gp_Pnt(x, y, z0 - kOverrun), gp_Dir(0, 0, 1)), 0.5 * d,
@@ -347,14 +362,7 @@ TopoDS_Shape build_counterbore_countersink(Dims& d) {
                                                          {rh, -T - kOverrun},
                                                          {0, -T - kOverrun}}};
         part = cut(part, revolve_polygon(f1, bore), "counterbore");
-        const gp_Ax2 f2(gp_Pnt(0.75 * L, y, T), gp_Dir(0, 0, 1), gp_Dir(1, 0, 0));
-        const double cone_depth = (rk - rs) / t;
-        const std::array<std::array<double, 2>, 5> sink{{{0, kOverrun},
-                                                         {rk + kOverrun * t, kOverrun},
-                                                         {rs, -cone_depth},
-                                                         {rs, -T - kOverrun},
-                                                         {0, -T - kOverrun}}};
-        part = cut(part, revolve_polygon(f2, sink), "countersink");
+        part = cut(part, countersink_tool(0.75 * L, y, T, rk, rs, t, T), "countersink");
     }
     return part;
 }
@@ -705,17 +713,10 @@ TopoDS_Shape build_countersink_bore(Dims& d) {
                               d.angle_deg("countersink_b_deg", 82),
                               d.angle_deg("countersink_c_deg", 120)};
     for (int i = 0; i < 3; ++i) {
-        const double half = deg(0.5 * angles[i]);
-        const double rb = 0.5 * bore, rc = 0.5 * csk;
-        const double cone_depth = (rc - rb) / std::tan(half);
-        const gp_Ax2 frame(gp_Pnt(L * (i + 1) / 4.0, 0.5 * W, T), gp_Dir(0, 0, 1), gp_Dir(1, 0, 0));
-        const std::array<std::array<double, 2>, 6> rh{{{0, kOverrun},
-                                                       {rc + kOverrun * std::tan(half), kOverrun},
-                                                       {rc, 0},
-                                                       {rb, -cone_depth},
-                                                       {rb, -T - kOverrun},
-                                                       {0, -T - kOverrun}}};
-        part = cut(part, revolve_polygon(frame, rh), "countersunk bore");
+        const double t = std::tan(deg(0.5 * angles[i]));
+        part =
+            cut(part, countersink_tool(L * (i + 1) / 4.0, 0.5 * W, T, 0.5 * csk, 0.5 * bore, t, T),
+                "countersunk bore");
     }
     return part;
 }

@@ -942,58 +942,48 @@ std::vector<Draft> paper_regions(Context& c, const std::vector<std::uint8_t>& ma
 }  // namespace
 
 Surface surface_from_record(const SurfaceRecord& rec) {
+    // The SRE layouts (sre-format.md): a point first; then the radius (sphere) or an axis (or
+    // the plane's normal) and the radius; then the kind's own parameters.
     const auto& p = rec.params;
-    Surface s;
-    const auto unit = [](double x, double y, double z) {
-        const Vec3 v{x, y, z};
+    const auto unit = [&](std::size_t i) {
+        const Vec3 v{p[i], p[i + 1], p[i + 2]};
         const double l = norm(v);
         return l > 0 ? v / l : Vec3{0, 0, 1};
     };
+    Surface s;
+    s.point = {p[0], p[1], p[2]};
+    if (rec.kind == SurfaceKind::kSphere) {
+        s.kind = FitKind::kSphere;
+        s.radius = p[3];
+        return s;
+    }
+    s.axis = unit(3);
+    s.radius = rec.kind == SurfaceKind::kPlane ? 0 : p[6];
     switch (rec.kind) {
         case SurfaceKind::kPlane:
             s.kind = FitKind::kPlane;
-            s.point = {p[0], p[1], p[2]};
-            s.axis = unit(p[3], p[4], p[5]);
             break;
         case SurfaceKind::kCylinder:
             s.kind = FitKind::kCylinder;
-            s.point = {p[0], p[1], p[2]};
-            s.axis = unit(p[3], p[4], p[5]);
-            s.radius = p[6];
             break;
         case SurfaceKind::kCone:
             s.kind = FitKind::kCone;
-            s.point = {p[0], p[1], p[2]};
-            s.axis = unit(p[3], p[4], p[5]);
-            s.radius = p[6];
             s.angle = p[7];
-            break;
-        case SurfaceKind::kSphere:
-            s.kind = FitKind::kSphere;
-            s.point = {p[0], p[1], p[2]};
-            s.radius = p[3];
             break;
         case SurfaceKind::kTorus:
             s.kind = FitKind::kTorus;
-            s.point = {p[0], p[1], p[2]};
-            s.axis = unit(p[3], p[4], p[5]);
-            s.radius = p[6];
             s.minor_radius = p[7];
             break;
         case SurfaceKind::kShearCylinder:
             s.kind = FitKind::kShearCylinder;
-            s.point = {p[0], p[1], p[2]};
-            s.axis = unit(p[3], p[4], p[5]);
-            s.radius = p[6];
-            s.sweep = unit(p[7], p[8], p[9]);
+            s.sweep = unit(7);
             break;
         case SurfaceKind::kSweptTorus:
             s.kind = FitKind::kSweptTorus;
-            s.point = {p[0], p[1], p[2]};
-            s.axis = unit(p[3], p[4], p[5]);
-            s.radius = p[6];
             s.minor_radius = p[7];
-            s.sweep = unit(p[8], p[9], p[10]);
+            s.sweep = unit(8);
+            break;
+        case SurfaceKind::kSphere:
             break;
     }
     return s;
@@ -1293,5 +1283,86 @@ std::vector<Draft> paper_regions(Context& c, const std::vector<std::uint8_t>& ma
 }
 
 }  // namespace
+
+}  // namespace ncrev
+
+namespace ncrev {
+
+RegionBorders region_borders(const Mesh& m, const FaceMap<std::int32_t>& face_region) {
+    const std::size_t nv = m.num_vertices();
+    // The region across half-edge h (-1 on the boundary).
+    const auto across = [&](HalfedgeId h) {
+        const HalfedgeId t = m.twin(h);
+        return t.is_valid() ? face_region[Mesh::face(t)] : -1;
+    };
+    // Each border edge is walked once, from the side of the larger region (the boundary, -1,
+    // is always on the right).
+    const auto is_border = [&](HalfedgeId h) { return face_region[Mesh::face(h)] > across(h); };
+    // Corners: vertices whose fan meets three or more sides (regions, the boundary as one).
+    RegionBorders out;
+    std::vector<std::uint8_t> corner(nv, 0);
+    std::vector<std::int32_t> sides;
+    for (std::uint32_t v = 0; v < nv; ++v) {
+        sides.clear();
+        bool boundary = false;
+        m.for_each_outgoing(VertexId(v), [&](HalfedgeId h) {
+            sides.push_back(face_region[Mesh::face(h)]);
+            boundary = boundary || !m.twin(h).is_valid() || !m.twin(Mesh::prev(h)).is_valid();
+        });
+        std::sort(sides.begin(), sides.end());
+        const std::size_t distinct =
+            static_cast<std::size_t>(std::unique(sides.begin(), sides.end()) - sides.begin());
+        if (distinct + (boundary ? 1 : 0) >= 3) {
+            corner[v] = 1;
+            out.corners.push_back(VertexId(v));
+        }
+    }
+    // Walk every border half-edge once, keeping its face's region on the left: from a
+    // border half-edge h (origin o, target t), the next one starts at t, is a border, and
+    // separates the same two sides.
+    std::vector<std::uint8_t> used(m.num_halfedges(), 0);
+    const auto next_along = [&](HalfedgeId h) {
+        const std::int32_t l = face_region[Mesh::face(h)], r = across(h);
+        HalfedgeId found;
+        m.for_each_outgoing(m.target(h), [&](HalfedgeId g) {
+            if (!found.is_valid() && !used[g.idx()] && is_border(g) &&
+                face_region[Mesh::face(g)] == l && across(g) == r)
+                found = g;
+        });
+        return found;
+    };
+    const auto walk = [&](HalfedgeId h0) {
+        BorderChain c;
+        c.left = face_region[Mesh::face(h0)];
+        c.right = across(h0);
+        c.vertices.push_back(m.origin(h0));
+        HalfedgeId h = h0;
+        for (;;) {
+            used[h.idx()] = 1;
+            const VertexId t = m.target(h);
+            c.vertices.push_back(t);
+            if (corner[t.idx()] || t == c.vertices.front()) break;
+            h = next_along(h);
+            if (!h.is_valid()) break;  // cannot happen on a manifold labelling; stay safe
+        }
+        c.closed = c.vertices.front() == c.vertices.back() && !corner[c.vertices.front().idx()];
+        out.chains.push_back(std::move(c));
+    };
+    // Chains from corners first (in vertex order), then the loops.
+    for (const VertexId v : out.corners) {
+        m.for_each_outgoing(v, [&](HalfedgeId h) {
+            if (!used[h.idx()] && is_border(h)) walk(h);
+        });
+    }
+    // A loop starts at its lowest vertex.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> rest;  // (origin, half-edge)
+    for (std::uint32_t h = 0; h < m.num_halfedges(); ++h)
+        if (!used[h] && is_border(HalfedgeId(h)))
+            rest.emplace_back(m.origin(HalfedgeId(h)).idx(), h);
+    std::sort(rest.begin(), rest.end());
+    for (const auto& [o, h] : rest)
+        if (!used[h]) walk(HalfedgeId(h));
+    return out;
+}
 
 }  // namespace ncrev
