@@ -11,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <optional>
@@ -73,6 +74,10 @@ constexpr std::size_t kSettledFacets = 4096;
 /// See firm_plane().
 constexpr std::size_t kFirmPlaneFacets = 8;
 constexpr double kFirmPlaneShare = 0.01;
+/// Segmenting again for noise: at kNoiseFactor x the measured RMS (the largest of a million
+/// gaussian deviates is about 5 sigma), at most kNoisePasses times.
+constexpr double kNoiseFactor = 6;
+constexpr int kNoisePasses = 3;
 /// Facets of each region that order the merge queue (see unlikeness()).
 constexpr std::size_t kLikenessSamples = 1024;
 /// Regions of at most this many facets are dissolved into their neighbours when these fit them.
@@ -1012,21 +1017,17 @@ double default_segment_tolerance(const Mesh& m, std::string* rule) {
     return std::max(by_size, by_precision);
 }
 
-Result<SegmentResult> segment(const Mesh& m, const SegmentOptions& options,
-                              const ProgressFn& progress) {
-    if (!std::isfinite(options.tolerance) || !std::isfinite(options.sharp_angle)) {
-        return Error{ErrorCode::kBadValue, "tolerance and sharp angle must be finite", {}, -1, -1};
-    }
+namespace {
+
+/// One segmentation at tolerance `tol` (see segment()).
+SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double tol,
+                          std::string rule, const ProgressFn& progress) {
     const auto t0 = Clock::now();
     SegmentResult result;
     result.method = options.method;
     Context c(m);
-    if (options.tolerance > 0) {
-        c.tol = options.tolerance;
-        result.tolerance_rule = "given";
-    } else {
-        c.tol = default_segment_tolerance(m, &result.tolerance_rule);
-    }
+    c.tol = tol;
+    result.tolerance_rule = std::move(rule);
     result.tolerance = c.tol;
     c.sharp = options.sharp_angle > 0 ? options.sharp_angle : kDefaultSegmentSharpAngle;
     result.sharp_angle = c.sharp;
@@ -1088,6 +1089,51 @@ Result<SegmentResult> segment(const Mesh& m, const SegmentOptions& options,
     result.fit_seconds = seconds_since(tf);
     if (progress) progress("fit", 1.0);
     return result;
+}
+
+/// The noise of a segmentation: the RMS residual of its largest segmented analytic region within
+/// the tolerance (a CAD tessellation's is rounding; a noisy mesh's is the noise, somewhat less
+/// since the region kept only the vertices within the tolerance).
+double noise_level(const SegmentResult& r) {
+    const Region* largest = nullptr;
+    for (const Region& g : r.regions) {
+        if (g.surface_index >= 0 || !g.within_tolerance || g.fit.surface.kind == FitKind::kBSpline)
+            continue;
+        if (largest == nullptr || g.facets > largest->facets) largest = &g;
+    }
+    return largest != nullptr ? largest->fit.rms : 0;
+}
+
+}  // namespace
+
+Result<SegmentResult> segment(const Mesh& m, const SegmentOptions& options,
+                              const ProgressFn& progress) {
+    if (!std::isfinite(options.tolerance) || !std::isfinite(options.sharp_angle)) {
+        return Error{ErrorCode::kBadValue, "tolerance and sharp angle must be finite", {}, -1, -1};
+    }
+    if (options.tolerance > 0) return run_segment(m, options, options.tolerance, "given", progress);
+    std::string rule;
+    double tol = default_segment_tolerance(m, &rule);
+    SegmentResult r = run_segment(m, options, tol, rule, progress);
+    // A noisy mesh: its vertices stray from their surfaces by more than the size-derived
+    // tolerance allows, and the faces break up. Segment again at kNoiseFactor x the noise the
+    // first pass measured (a few passes: a region that kept only the vertices within the
+    // tolerance understates the noise).
+    double seconds = r.curvature_seconds + r.segment_seconds + r.fit_seconds;
+    // (The facets method's: the paper's regions are too loose a measure of the noise.)
+    for (int pass = 0; pass < kNoisePasses && options.method == SegmentMethod::kFacets; ++pass) {
+        const double sigma = noise_level(r);
+        if (!(kNoiseFactor * sigma > tol)) break;
+        tol = kNoiseFactor * sigma;
+        char buf[160];
+        std::snprintf(buf, sizeof buf,
+                      "%g x the noise (RMS %.3g of the largest region, segmented again)",
+                      kNoiseFactor, sigma);
+        r = run_segment(m, options, tol, buf, progress);
+        r.segment_seconds += seconds;  // the earlier passes count
+        seconds = r.curvature_seconds + r.segment_seconds + r.fit_seconds;
+    }
+    return r;
 }
 
 std::vector<std::int32_t> input_labels(const Mesh& m, const SegmentResult& result,
