@@ -130,6 +130,15 @@ struct SamplePart {
 /// the same name and options give byte-identical outputs.
 Result<SamplePart> make_sample_part(std::string_view name, const SampleOptions& options = {});
 
+/// A STEP file's solid (the largest, when it holds several) described and tessellated like a
+/// sample part: labels, faces, surfaces, truth document; `name` is the file's stem, `seed` and
+/// `dimensions` are empty, `options.with_step` writes the solid back. The solid need not pass
+/// BRepCheck (`solid.valid` says whether it does): real files often do not. Errors: kBadSyntax
+/// when OpenCASCADE cannot read the file, kBadValue when it holds no solid or meshing fails;
+/// the error names the file. Never throws, never prints.
+Result<SamplePart> sample_from_step(const std::filesystem::path& path,
+                                    const SampleOptions& options = {});
+
 /// The files write_sample_part() wrote.
 struct SampleFiles {
     std::filesystem::path folder, stl, sre, step, labels, truth;

@@ -9,6 +9,8 @@
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
 #include <GProp_GProps.hxx>
+#include <IFSelect_ReturnStatus.hxx>
+#include <STEPControl_Reader.hxx>
 #include <Standard_Failure.hxx>
 #include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
@@ -16,6 +18,7 @@
 #include <TopoDS.hxx>
 #include <atomic>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "brep/step.h"
@@ -177,14 +180,83 @@ std::span<const SamplePartInfo> sample_parts() {
 
 bool is_sample_part(std::string_view name) { return find_part(name) != nullptr; }
 
+namespace {
+
+bool options_ok(const SampleOptions& options) {
+    return options.angular_deflection > 0 && std::isfinite(options.angular_deflection) &&
+           std::isfinite(options.deflection) && options.relative_deflection > 0 &&
+           std::isfinite(options.relative_deflection);
+}
+
+/// The numbers of `solid`, its tessellation with face labels, the truth document and (with
+/// options.with_step) the STEP text, into `part`. Throws sd::ModelError or Standard_Failure;
+/// an error is returned for a solid that is not valid and closed when `require_valid`.
+std::optional<Error> build_part(const TopoDS_Shape& solid, const SampleOptions& options,
+                                std::string_view description, bool require_valid,
+                                SamplePart& part) {
+    SampleSolid& s = part.solid;
+    GProp_GProps vprops, sprops;
+    BRepGProp::VolumeProperties(solid, vprops);
+    BRepGProp::SurfaceProperties(solid, sprops);
+    s.volume = vprops.Mass();
+    s.area = sprops.Mass();
+    Bnd_Box box;
+    BRepBndLib::AddOptimal(solid, box, /*useTriangulation=*/false,
+                           /*useShapeTolerance=*/false);
+    double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;
+    box.Get(x0, y0, z0, x1, y1, z1);
+    s.bbox.add(Vec3{x0, y0, z0});
+    s.bbox.add(Vec3{x1, y1, z1});
+    TopTools_IndexedMapOfShape faces, edges, vertices;
+    TopExp::MapShapes(solid, TopAbs_FACE, faces);
+    TopExp::MapShapes(solid, TopAbs_EDGE, edges);
+    TopExp::MapShapes(solid, TopAbs_VERTEX, vertices);
+    s.num_faces = static_cast<std::uint64_t>(faces.Extent());
+    s.num_edges = static_cast<std::uint64_t>(edges.Extent());
+    s.num_vertices = static_cast<std::uint64_t>(vertices.Extent());
+    s.valid = BRepCheck_Analyzer(solid).IsValid();
+    s.closed = is_closed(solid);
+    if (require_valid && (!s.valid || !s.closed || !(s.volume > 0))) {
+        return make_error(ErrorCode::kBadValue, "part '" + part.name + "' (seed " +
+                                                    std::to_string(options.seed) +
+                                                    ") is not a valid closed solid");
+    }
+
+    part.deflection = options.deflection > 0 ? options.deflection
+                                             : options.relative_deflection * s.bbox.diagonal();
+    {
+        std::ostringstream rule;
+        if (options.deflection > 0) {
+            rule << "given";
+        } else {
+            rule << options.relative_deflection << " x bounding-box diagonal";
+        }
+        part.deflection_rule = rule.str();
+    }
+    BRepMesh_IncrementalMesh mesher(solid, part.deflection, /*isRelative=*/false,
+                                    part.angular_deflection, /*isInParallel=*/false);
+    if (!mesher.IsDone()) throw sd::ModelError("meshing failed");
+    std::vector<Json> face_params;
+    sd::tessellate_solid(solid, part, face_params);
+    part.truth_json = truth_document(part, description, face_params);
+    if (options.with_step) {
+        part.step = sd::step_text(solid, part.name);
+        if (part.step.empty()) {
+            return make_error(ErrorCode::kCannotWrite,
+                              "cannot produce the STEP text of '" + part.name + "'");
+        }
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
 Result<SamplePart> make_sample_part(std::string_view name, const SampleOptions& options) {
     const sd::PartEntry* entry = find_part(name);
     if (entry == nullptr) {
         return make_error(ErrorCode::kBadValue, "unknown sample part '" + std::string(name) + "'");
     }
-    if (!(options.angular_deflection > 0) || !std::isfinite(options.angular_deflection) ||
-        !std::isfinite(options.deflection) || !(options.relative_deflection > 0) ||
-        !std::isfinite(options.relative_deflection)) {
+    if (!options_ok(options)) {
         return make_error(ErrorCode::kBadValue,
                           "deflection must be finite, angular and relative deflection positive");
     }
@@ -197,64 +269,65 @@ Result<SamplePart> make_sample_part(std::string_view name, const SampleOptions& 
         sd::Dims dims(name, options.seed);
         const TopoDS_Shape solid = single_solid(entry->build(dims));
         part.dimensions = dims.take();
-
-        SampleSolid& s = part.solid;
-        GProp_GProps vprops, sprops;
-        BRepGProp::VolumeProperties(solid, vprops);
-        BRepGProp::SurfaceProperties(solid, sprops);
-        s.volume = vprops.Mass();
-        s.area = sprops.Mass();
-        Bnd_Box box;
-        BRepBndLib::AddOptimal(solid, box, /*useTriangulation=*/false,
-                               /*useShapeTolerance=*/false);
-        double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;
-        box.Get(x0, y0, z0, x1, y1, z1);
-        s.bbox.add(Vec3{x0, y0, z0});
-        s.bbox.add(Vec3{x1, y1, z1});
-        TopTools_IndexedMapOfShape faces, edges, vertices;
-        TopExp::MapShapes(solid, TopAbs_FACE, faces);
-        TopExp::MapShapes(solid, TopAbs_EDGE, edges);
-        TopExp::MapShapes(solid, TopAbs_VERTEX, vertices);
-        s.num_faces = static_cast<std::uint64_t>(faces.Extent());
-        s.num_edges = static_cast<std::uint64_t>(edges.Extent());
-        s.num_vertices = static_cast<std::uint64_t>(vertices.Extent());
-        s.valid = BRepCheck_Analyzer(solid).IsValid();
-        s.closed = is_closed(solid);
-        if (!s.valid || !s.closed || !(s.volume > 0)) {
-            return make_error(ErrorCode::kBadValue, "part '" + part.name + "' (seed " +
-                                                        std::to_string(options.seed) +
-                                                        ") is not a valid closed solid");
-        }
-
-        part.deflection = options.deflection > 0 ? options.deflection
-                                                 : options.relative_deflection * s.bbox.diagonal();
-        {
-            std::ostringstream rule;
-            if (options.deflection > 0) {
-                rule << "given";
-            } else {
-                rule << options.relative_deflection << " x bounding-box diagonal";
-            }
-            part.deflection_rule = rule.str();
-        }
-        BRepMesh_IncrementalMesh mesher(solid, part.deflection, /*isRelative=*/false,
-                                        part.angular_deflection, /*isInParallel=*/false);
-        if (!mesher.IsDone()) throw sd::ModelError("meshing failed");
-        std::vector<Json> face_params;
-        sd::tessellate_solid(solid, part, face_params);
-        part.truth_json = truth_document(part, entry->info.description, face_params);
-        if (options.with_step) {
-            part.step = sd::step_text(solid, part.name);
-            if (part.step.empty()) {
-                return make_error(ErrorCode::kCannotWrite,
-                                  "cannot produce the STEP text of '" + part.name + "'");
-            }
-        }
+        if (auto e = build_part(solid, options, entry->info.description, true, part)) return *e;
     } catch (const Standard_Failure& e) {
         return make_error(ErrorCode::kBadValue, "part '" + part.name + "': OpenCASCADE: " +
                                                     std::string(e.GetMessageString()));
     } catch (const std::exception& e) {
         return make_error(ErrorCode::kBadValue, "part '" + part.name + "': " + e.what());
+    }
+    return part;
+}
+
+Result<SamplePart> sample_from_step(const std::filesystem::path& path,
+                                    const SampleOptions& options) {
+    if (!options_ok(options)) {
+        return make_error(ErrorCode::kBadValue,
+                          "deflection must be finite, angular and relative deflection positive");
+    }
+    sd::silence_occt();
+    SamplePart part;
+    part.name = path.stem().string();
+    part.angular_deflection = options.angular_deflection;
+    try {
+        STEPControl_Reader reader;
+        if (reader.ReadFile(path.string().c_str()) != IFSelect_RetDone) {
+            Error e = make_error(ErrorCode::kBadSyntax, "not a STEP file OpenCASCADE can read");
+            e.path = path.string();
+            return e;
+        }
+        reader.TransferRoots();
+        const TopoDS_Shape shape = reader.OneShape();
+        TopTools_IndexedMapOfShape solids;
+        TopExp::MapShapes(shape, TopAbs_SOLID, solids);
+        if (solids.Extent() == 0) {
+            Error e = make_error(ErrorCode::kBadValue, "the STEP file holds no solid");
+            e.path = path.string();
+            return e;
+        }
+        // The largest solid (an assembly's main part; most files hold one).
+        int best = 1;
+        double best_volume = -1;
+        for (int i = 1; i <= solids.Extent(); ++i) {
+            GProp_GProps props;
+            BRepGProp::VolumeProperties(solids(i), props);
+            if (std::abs(props.Mass()) > best_volume)
+                best_volume = std::abs(props.Mass()), best = i;
+        }
+        std::string description = "solid from " + path.filename().string();
+        if (solids.Extent() > 1) {
+            description += " (the largest of " + std::to_string(solids.Extent()) + ")";
+        }
+        if (auto e = build_part(solids(best), options, description, false, part)) return *e;
+    } catch (const Standard_Failure& e) {
+        Error err =
+            make_error(ErrorCode::kBadValue, "OpenCASCADE: " + std::string(e.GetMessageString()));
+        err.path = path.string();
+        return err;
+    } catch (const std::exception& e) {
+        Error err = make_error(ErrorCode::kBadValue, e.what());
+        err.path = path.string();
+        return err;
     }
     return part;
 }
