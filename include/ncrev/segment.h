@@ -3,12 +3,13 @@
 // Two methods:
 // - facets (the default, it measures better, docs/segmentation.md): sharp edges (dihedral
 //   angle) split the mesh into smooth patches; each patch is grown region by region from its
-//   most interior facets, a region taking a neighbouring facet while one analytic surface keeps
-//   every vertex within the tolerance and agrees with every facet's normal (so a fillet stops
-//   where the plane it is tangent to begins: the type changes, the fit fails); adjacent regions
-//   that one surface fits are merged, most alike first; groups of small curved pieces that one
-//   B-spline fits become one free-form region; border facets go to the neighbouring region they
-//   fit best.
+//   flattest, most interior facets, a region taking a neighbouring facet while the facets are
+//   chords of one analytic surface: corners within the tolerance, middles within the mesh's
+//   chordal deflection, normals agreeing (so a fillet stops where the plane it is tangent to
+//   begins: the type changes, the fit fails); adjacent regions that one surface fits are
+//   merged, most alike first; groups of small curved pieces that one B-spline fits become one
+//   free-form region; border facets go to the neighbouring region they fit best. A noisy mesh
+//   is segmented again at a tolerance raised to its measured noise.
 // - paper: the paper's vertex method: vertex types from `curvature`, high-curvature points set
 //   aside, refining over one-rings, connected components, merging region pairs through a
 //   priority queue while one surface fits the union, then the set-aside points and the facets.
