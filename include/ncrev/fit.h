@@ -78,6 +78,26 @@ double distance(const Surface& s, Vec3 p);
 /// a sphere's or torus's center, one of the nearest points).
 Vec3 closest_point(const Surface& s, Vec3 p);
 
+/// The unit normal of the surface at its point nearest to `p` (its sign carries no meaning).
+Vec3 normal_at(const Surface& s, Vec3 p);
+
+/// A point on several surfaces at once: where a B-rep vertex is (method.md Step 2b.3: a corner
+/// solved onto its three or more surfaces, starting from the mesh vertex).
+struct CommonPoint {
+    Vec3 point;
+    double residual = 0;  ///< the largest distance from `point` to the surfaces
+    int iterations = 0;
+};
+
+/// Gauss–Newton from `start` on the distances to `surfaces`: each step is the least-norm
+/// correction that puts the point on every surface's tangent plane, so where fewer than three
+/// surfaces fix it, the point moves no farther from `start` than it must. Three surfaces that
+/// cross are met to rounding in a few steps. Two tangent surfaces (a fillet and its plane:
+/// parallel normals) are NOT: first-order steps cannot find their tangency line, and the
+/// residual stays at about curvature x (distance from that line)^2 — read `residual`. Stops at
+/// rounding level or after 50 steps. Deterministic; never throws.
+CommonPoint common_point(std::span<const Surface> surfaces, Vec3 start);
+
 /// Points to fit: positions, and optionally unit normals and weights (e.g. facet centroids,
 /// their normals and areas). Empty `normals` or `weights` spans mean none / all 1.
 struct FitInput {

@@ -15,6 +15,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <Eigen/Dense>
+#include <Eigen/QR>
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
@@ -1227,6 +1228,97 @@ Vec3 closest_point(const Surface& s, Vec3 p) {
         }
     }
     return p;
+}
+
+Vec3 normal_at(const Surface& s, Vec3 p) {
+    const Vec3 q = closest_point(s, p);
+    const auto unit_or = [](Vec3 v, Vec3 fallback) {
+        const double l = norm(v);
+        return l > 0 ? v / l : fallback;
+    };
+    switch (s.kind) {
+        case FitKind::kPlane:
+            return s.axis;
+        case FitKind::kSphere:
+            return unit_or(q - s.point, s.axis);
+        case FitKind::kCylinder:
+        case FitKind::kCone:
+        case FitKind::kTorus: {
+            const Vec3 w = q - s.point;
+            Vec3 e = w - dot(w, s.axis) * s.axis;
+            const double rho = norm(e);
+            if (rho > 0) {
+                e = e / rho;
+            } else {
+                Vec3 v;
+                frame(s.axis, e, v);
+            }
+            if (s.kind == FitKind::kCylinder) return e;
+            if (s.kind == FitKind::kCone) return std::cos(s.angle) * e - std::sin(s.angle) * s.axis;
+            return unit_or(q - (s.point + s.radius * e), e);
+        }
+        case FitKind::kShearCylinder:
+        case FitKind::kSweptTorus: {
+            const EllipticCylinder e = elliptic_of(s.point, s.axis, s.radius, s.sweep);
+            double x, y, ex, ey, nx, ny, h;
+            e.signed_distance(p, x, y, ex, ey, nx, ny, h);
+            const Vec3 m = cross(e.d, e.w);
+            const Vec3 ellipse_normal = unit_or(nx * e.w + ny * m, e.w);
+            if (s.kind == FitKind::kShearCylinder) return ellipse_normal;
+            const Vec3 on = e.c + h * e.d + ex * e.w + ey * m;
+            return unit_or(q - on, ellipse_normal);
+        }
+        case FitKind::kBSpline: {
+            if (!s.bspline) return s.axis;
+            double u = 0.5, v = 0.5;
+            coarse_start(*s.bspline, p, u, v);
+            project_bspline(*s.bspline, p, u, v);
+            Vec3 at, du, dv;
+            s.bspline->evaluate(u, v, at, du, dv);
+            return unit_or(cross(du, dv), s.axis);
+        }
+    }
+    return s.axis;
+}
+
+CommonPoint common_point(std::span<const Surface> surfaces, Vec3 start) {
+    constexpr int kMaxSteps = 50;
+    CommonPoint out;
+    out.point = start;
+    const std::size_t k = surfaces.size();
+    if (k == 0 || !finite(start)) return out;
+    // Rounding level of the coordinates: the scale of the point and of the surfaces' anchors.
+    double scale = norm(start);
+    for (const Surface& s : surfaces) scale = std::max(scale, norm(s.point) + s.radius);
+    const double eps = 1e-14 * std::max(1.0, scale);
+    Eigen::MatrixXd J(static_cast<Eigen::Index>(k), 3);
+    Eigen::VectorXd r(static_cast<Eigen::Index>(k));
+    Vec3 p = start;
+    for (int it = 0; it < kMaxSteps; ++it) {
+        double worst = 0;
+        for (std::size_t i = 0; i < k; ++i) {
+            const Vec3 n = normal_at(surfaces[i], p);
+            const double d = dot(p - closest_point(surfaces[i], p), n);
+            J.row(static_cast<Eigen::Index>(i)) << n.x, n.y, n.z;
+            r(static_cast<Eigen::Index>(i)) = d;
+            worst = std::max(worst, std::abs(d));
+        }
+        out.iterations = it;
+        if (worst <= eps) break;
+        // Least-norm least squares: directions the normals do not fix are left alone
+        // (parallel normals of tangent surfaces count as one, below a thousandth).
+        Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(J);
+        cod.setThreshold(1e-3);
+        const Eigen::Vector3d step = -cod.solve(r);
+        const Vec3 dp{step(0), step(1), step(2)};
+        if (!finite(dp)) break;
+        p = p + dp;
+        if (norm(dp) <= eps) break;
+    }
+    out.point = p;
+    out.residual = 0;
+    for (const Surface& s : surfaces) out.residual = std::max(out.residual, distance(s, p));
+    return out;
 }
 
 FitResult fit_bspline(const FitInput& in, double tolerance) {

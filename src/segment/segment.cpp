@@ -221,72 +221,20 @@ double estimate_sag(const Context& c) {
     return std::max(c.tol, kSagFactor * *q);
 }
 
-/// The surface's unit normal near `p` (a facet centroid): in closed form for plane to torus,
-/// otherwise from the closest points of two probes on either side along the facet normal
-/// `hint` (the sheared kinds, the B-spline).
-Vec3 surface_normal(const Surface& s, Vec3 p, Vec3 hint, double h) {
-    // The surfaces of revolution have their normal in closed form (up to sign, which the
-    // callers ignore); only off their axis, which a facet of the surface never touches.
-    const auto radial = [&](Vec3& dir) {
-        const Vec3 q = p - s.point;
-        const Vec3 r = q - s.axis * dot(q, s.axis);
-        const double l = norm(r);
-        if (!(l > 0)) return false;
-        dir = r / l;
-        return true;
-    };
-    Vec3 rho;
-    switch (s.kind) {
-        case FitKind::kPlane:
-            return s.axis;
-        case FitKind::kSphere: {
-            const Vec3 q = p - s.point;
-            const double l = norm(q);
-            if (l > 0) return q / l;
-            break;
-        }
-        case FitKind::kCylinder:
-            if (radial(rho)) return rho;
-            break;
-        case FitKind::kCone:
-            if (radial(rho)) return rho * std::cos(s.angle) - s.axis * std::sin(s.angle);
-            break;
-        case FitKind::kTorus:
-            if (radial(rho)) {
-                const Vec3 q = p - (s.point + rho * s.radius);
-                const double l = norm(q);
-                if (l > 0) return q / l;
-            }
-            break;
-        default:
-            break;
-    }
-    Vec3 best = hint;
-    double best_len = 0;
-    for (const double sign : {1.0, -1.0}) {
-        const Vec3 q = p + hint * (sign * h);
-        const Vec3 d = q - closest_point(s, q);
-        const double l = norm(d);
-        if (l > best_len) best_len = l, best = d / l;
-    }
-    return best;
-}
-
 /// The facet's normal is the surface's at its middle within kSegmentNormalAngle, or within the
 /// turn of the surface's normal across the facet (its corners' normals) when that is larger: a
 /// chord's normal is one of the normals it spans, and the large fan triangles of a coarse torus
 /// span 40 degrees.
 bool normal_agrees(const Context& c, const Surface& s, std::uint32_t f) {
     const Vec3 n = c.fd.normal[f];
-    const double h = 4 * c.tol;
-    const Vec3 sn = surface_normal(s, c.fd.centroid[f], n, h);
+    const Vec3 sn = normal_at(s, c.fd.centroid[f]);
     const double cos_mid = std::abs(dot(sn, n));
     if (cos_mid >= c.cos_normal) return true;
     if (s.kind == FitKind::kPlane) return false;
     double cos_span = 1;
     for (int i = 0; i < 3; ++i) {
         const Vec3 p = c.m.position(c.m.vertex(fid(f), i));
-        cos_span = std::min(cos_span, std::abs(dot(surface_normal(s, p, n, h), sn)));
+        cos_span = std::min(cos_span, std::abs(dot(normal_at(s, p), sn)));
     }
     return cos_mid >= cos_span;
 }
