@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Builds Release and runs every benchmark (ncrev and, when installed, OpenMesh and CGAL in the
-# same binary), 3 repetitions, medians; JSON beside the text. Takes about 10 minutes.
+# same binary), 3 repetitions, medians; JSON beside the text. Takes about 25 minutes: the
+# segmentation rows run once per repetition and the paper method needs 1.5 min at 5M facets;
+# --benchmark_filter narrows it.
 # Usage: bench/run.sh [OUT_PREFIX] [--benchmark_filter=REGEX]
 set -euo pipefail
 cd "$(dirname "$0")/.."
