@@ -1,7 +1,7 @@
 // Peer for segmentation (issue 7): CGAL's Efficient RANSAC shape detection with all five
 // primitive kinds (plane, sphere, cylinder, cone, torus), what a CGAL user would run to split a
 // scanned part into primitives, on the vertices (with their normals) of the same generated
-// meshes as segment_bench.cpp. Its epsilon is ncrev's derived tolerance (2e-4 x the diagonal),
+// meshes as segment_bench.cpp. Its epsilon is ncrev's derived tolerance (1e-4 x the diagonal),
 // cluster epsilon three times the mean edge length, at least 0.5 % of the points per shape.
 // It labels points, not facets, and leaves unassigned points; ncrev labels every facet.
 #include <map>

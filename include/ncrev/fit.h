@@ -118,6 +118,10 @@ struct FitResult {
     std::string failure;
 };
 
+/// `surface` as it is, with the residuals of `input` (weighted RMS, max): what fit() reports,
+/// for a surface given rather than fitted (an SRE record, a kept fit on changed points).
+FitResult residuals(const Surface& surface, const FitInput& input);
+
 /// Fits one kind. Cylinders, cones and tori need normals for their start (the axis is found
 /// as the line that meets every normal line); spheres and planes do not. A B-spline is fitted
 /// to within 1e-4 of the points' extent (see fit_bspline()). Never throws.

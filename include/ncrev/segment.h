@@ -35,12 +35,12 @@ enum class SegmentMethod { kFacets, kPaper };
 /// "facets", "paper".
 const char* to_string(SegmentMethod method);
 
-/// Default tolerance as a fraction of the bounding-box diagonal: 0.02 mm on a 100 mm part, a
-/// fifth of a general machining tolerance. The vertices of a CAD tessellation lie on the
-/// surface they sample to float rounding, except near fillet edges, which CAD kernels hold to
-/// about 1e-4 of the part (OpenCASCADE: 0.013 mm on a 125 mm part); vertices further than this
-/// from a region's surface belong to another surface. A noisy mesh raises it (segment()).
-constexpr double kSegmentRelativeTolerance = 2e-4;
+/// Default tolerance as a fraction of the bounding-box diagonal: 0.01 mm on a 100 mm part, a
+/// tenth of a general machining tolerance. The vertices of a CAD tessellation lie on the
+/// surface they sample to float rounding (`ncrev segment PART.sre --json`: every given
+/// surface's max residual is 0); vertices further than this from a region's surface belong to
+/// another surface. A noisy mesh raises it (segment()).
+constexpr double kSegmentRelativeTolerance = 1e-4;
 /// Default sharp-edge angle (rad, 30 degrees): above the normal step inside curved faces of
 /// usual tessellations (20 degrees and less), below a 45-degree chamfer or countersink. It only
 /// cuts the mesh into patches to grow in: fitting decides, so a missed sharp edge is still a

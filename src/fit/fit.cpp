@@ -661,6 +661,18 @@ FitResult finish(const Model& model, int iterations, const FitInput& in) {
     return res;
 }
 
+}  // namespace
+
+FitResult residuals(const Surface& surface, const FitInput& in) {
+    struct Fixed {
+        Surface s;
+        Surface surface() const { return s; }
+    };
+    return finish(Fixed{surface}, 0, in);
+}
+
+namespace {
+
 FitResult failed(FitKind kind, std::string why) {
     FitResult r;
     r.surface.kind = kind;
@@ -693,11 +705,7 @@ FitResult fit_plane(const FitInput& in) {
             agree += weight(in, i) * dot(in.normals[i], s.axis);
         if (agree < 0) s.axis = -s.axis;
     }
-    struct Wrap {
-        Surface s;
-        Surface surface() const { return s; }
-    };
-    return finish(Wrap{s}, 0, in);
+    return residuals(s, in);
 }
 
 FitResult fit_sphere(const FitInput& in) {
@@ -1440,13 +1448,9 @@ FitResult refit_surface(const Surface& s, unsigned frozen, const FitInput& in) {
     switch (s.kind) {
         case FitKind::kPlane: {
             // A held normal: the best plane passes through the weighted centroid.
-            struct Wrap {
-                Surface s;
-                Surface surface() const { return s; }
-            };
             Surface p = s;
             p.point = centroid(in);
-            return finish(Wrap{p}, 0, in);
+            return residuals(p, in);
         }
         case FitKind::kSphere:
             return refit(SphereModel{s.point, s.radius}, frozen, in);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 namespace ncrev {
 
@@ -320,7 +321,7 @@ std::string to_text(const SegmentResult& r, Unit unit) {
     std::snprintf(buf, sizeof buf,
                   "tolerance %.4g %s (%s), chordal deflection %.4g %s, sharp edges from %.1f deg\n",
                   r.tolerance, to_string(unit), r.tolerance_rule.c_str(), r.chordal_deflection,
-                  to_string(unit), r.sharp_angle * 180 / 3.14159265358979323846);
+                  to_string(unit), r.sharp_angle * 180 / std::numbers::pi);
     s += buf;
     if (r.given_facets) s += std::to_string(r.given_facets) + " facets kept their SRE surface\n";
     if (outside)

@@ -799,37 +799,22 @@ Region final_region(Context& c, const Draft& d, std::span<const SurfaceRecord> r
     PointSet ps;
     c.gatherers.local().gather(c.m, c.fd, d.faces, ps);
     const FitInput in = ps.input();
-    const auto residuals = [&](const Surface& s) {
-        FitResult r;
-        r.ok = true;
-        r.surface = s;
-        double sum = 0, wsum = 0;
-        for (std::size_t i = 0; i < ps.points.size(); ++i) {
-            const double e = distance(s, ps.points[i]);
-            sum += ps.weights[i] * e * e;
-            wsum += ps.weights[i];
-            r.max = std::max(r.max, e);
-        }
-        r.rms = wsum > 0 ? std::sqrt(sum / wsum) : 0;
-        return r;
-    };
     if (d.surface_index >= 0) {
         out.fit =
-            residuals(surface_from_record(records[static_cast<std::size_t>(d.surface_index)]));
+            residuals(surface_from_record(records[static_cast<std::size_t>(d.surface_index)]), in);
     } else if (d.surface.kind == FitKind::kBSpline) {
         out.fit = fit_bspline(FitInput{ps.points, ps.normals, {}}, c.sag);  // as merge_freeform()
-        if (!out.fit.ok) out.fit = residuals(d.surface);
+        if (!out.fit.ok) out.fit = residuals(d.surface, in);
     } else {
         // A settled region's own kind first (no four failed fits to a million facets of a
         // torus); otherwise the simplest kind afresh (a band of a cone grown from a few
         // facets that a sphere fitted is a cone).
-        out.fit = residuals(d.surface);
         FitResult same;
         if (settled(d)) same = fit(d.surface.kind, in);
         if (same.ok && same.max <= c.tol && chords_agree(c, same.surface, d.faces))
             out.fit = std::move(same);
         else
-            out.fit = select_kind(c, in, d.faces, out.fit);
+            out.fit = select_kind(c, in, d.faces, residuals(d.surface, in));
     }
     out.within_tolerance =
         out.fit.ok && out.fit.max <= (out.fit.surface.kind == FitKind::kBSpline ? c.sag : c.tol);
@@ -959,8 +944,8 @@ double default_segment_tolerance(const Mesh& m, std::string* rule) {
     const double by_precision = kPrecisionFactor * precision;
     if (rule) {
         *rule = by_size >= by_precision
-                    ? "2e-4 x the bounding-box diagonal"
-                    : "16 x the coordinates' rounding unit (above 2e-4 x the diagonal)";
+                    ? "1e-4 x the bounding-box diagonal"
+                    : "16 x the coordinates' rounding unit (above 1e-4 x the diagonal)";
     }
     return std::max(by_size, by_precision);
 }
