@@ -1,18 +1,25 @@
-// `ncrev reverse INPUT -o OUTPUT.step --method facets|planar`: the mesh as a STEP solid.
+// `ncrev reverse INPUT -o OUTPUT.step [--method auto|surfaces|planar|facets]`: the mesh as a STEP
+// solid.
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <map>
+#include <span>
 
 #include "commands.h"
 #include "ncrev/brep.h"
 #include "ncrev/report.h"
+#include "ncrev/segment.h"
 
 namespace ncrev::cli {
 namespace {
 
 struct ReverseCliOptions {
-    std::string input, output, report;
-    ReverseMethod method = ReverseMethod::kPlanar;
+    std::string input, output, report, labels, segments;
+    ReverseMethod method = ReverseMethod::kAuto;
+    double tolerance = 0;
+    bool no_colors = false;
+    bool no_surfaces = false;
     StepSchema schema = StepSchema::kAP214;
     bool require_solid = false;
     bool json = false;
@@ -23,19 +30,41 @@ void add_reverse(CLI::App& app, Context& ctx) {
     auto o = std::make_shared<ReverseCliOptions>();
     CLI::App* cmd = app.add_subcommand(
         "reverse",
-        "Rebuild a CAD solid from a mesh (STL or SRE) and write it as STEP. Methods: 'facets' "
-        "gives one planar face per facet (the paper's method 1); 'planar' (default) merges "
-        "coplanar neighbours into one planar face with its outer and inner wires, so a "
-        "prismatic part comes back with its true faces. A closed mesh gives a solid; an open "
-        "one a shell (a surface model) and a warning.");
+        "Rebuild a CAD solid from a mesh (STL or SRE) and write it as STEP. Methods: 'auto' "
+        "(default) segments the mesh into regions (an SRE file's surface indices kept), fits "
+        "each one surface (plane, cylinder, cone, sphere, torus, B-spline) and builds one "
+        "face per region, its edges where the surfaces meet; a region whose face cannot be "
+        "built comes back as its facets and is reported. 'surfaces' is the same but fails "
+        "(exit 3, nothing written) rather than fall back. 'planar' merges coplanar facets "
+        "into planar faces; 'facets' gives one planar face per facet (the paper's method 1). "
+        "A closed mesh gives a solid; an open one a shell (a surface model, planar method) "
+        "and a warning. Faces carry colors: the SRE tool color, else one per surface kind.");
     cmd->add_option("INPUT", o->input, "Mesh file: .stl (ASCII or binary) or .sre")->required();
     cmd->add_option("-o,--output", o->output, "STEP file to write (atomically)")->required();
-    const std::map<std::string, ReverseMethod> methods{{"facets", ReverseMethod::kFacets},
+    const std::map<std::string, ReverseMethod> methods{{"auto", ReverseMethod::kAuto},
+                                                       {"surfaces", ReverseMethod::kSurfaces},
+                                                       {"facets", ReverseMethod::kFacets},
                                                        {"planar", ReverseMethod::kPlanar}};
     cmd->add_option("--method", o->method,
-                    "facets: one planar face per facet; planar: coplanar facets merged (default)")
+                    "auto (default): true surfaces, regions that fail as facets; surfaces: "
+                    "true surfaces or nothing; planar: coplanar facets merged; facets: one face "
+                    "per facet")
         ->transform(CLI::CheckedTransformer(methods, CLI::ignore_case))
-        ->option_text("facets|planar");
+        ->option_text("auto|surfaces|planar|facets");
+    cmd->add_option("--labels", o->labels,
+                    "auto/surfaces: also write the region of every input facet, one per line, "
+                    "in input order (-1 for a facet that healing removed)");
+    cmd->add_option("--segments", o->segments,
+                    "auto/surfaces: also write the regions as a binary PLY (faces carry "
+                    "'region' and 'red green blue'), as `ncrev segment` does");
+    cmd->add_option("--tolerance", o->tolerance,
+                    "auto/surfaces: largest distance of a vertex from its region's surface, in "
+                    "the file's unit (default: 1e-4 x the bounding-box diagonal, raised to the "
+                    "noise of a noisy mesh)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_flag("--no-surface-indices", o->no_surfaces,
+                  "Segment every facet, ignoring the surface indices of an SRE file");
+    cmd->add_flag("--no-colors", o->no_colors, "Write plain geometry, without face colors");
     const std::map<std::string, StepSchema> schemas{{"ap214", StepSchema::kAP214},
                                                     {"ap203", StepSchema::kAP203},
                                                     {"ap242", StepSchema::kAP242}};
@@ -43,14 +72,24 @@ void add_reverse(CLI::App& app, Context& ctx) {
         ->transform(CLI::CheckedTransformer(schemas, CLI::ignore_case))
         ->option_text("ap214|ap203|ap242");
     cmd->add_option("--report", o->report,
-                    "Write a JSON report: stages with timings, healing, faces by kind, edges, "
-                    "vertices, whether the result is a closed valid solid, volumes and areas");
+                    "Write a JSON report: stages with timings, healing, regions, faces by kind, "
+                    "fallbacks, edges, vertices, whether the result is a closed valid solid, "
+                    "volumes, areas and the deviation between the solid and the mesh");
     cmd->add_flag("--require-solid", o->require_solid,
                   "Fail (exit 3, nothing written) unless the result is a closed solid");
     cmd->add_flag("--json", o->json, "Print the report (as --report writes it) on stdout");
     cmd->add_flag("-q,--quiet", o->quiet, "No warnings and no progress on stderr");
     cmd->callback([o, &ctx]() {
         const std::filesystem::path in(o->input), out(o->output);
+        for (const std::string* extra : {&o->labels, &o->segments, &o->report}) {
+            std::error_code ec;
+            if (!extra->empty() && (std::filesystem::equivalent(in, *extra, ec) ||
+                                    std::filesystem::path(*extra) == out)) {
+                print_error(*extra + " would overwrite the input or the output");
+                ctx.exit_code = kExitUsage;
+                return;
+            }
+        }
         auto healed = read_input(in, out, ctx, o->quiet);
         if (!healed) return;
         const auto progress = terminal_progress(ctx, o->quiet);
@@ -67,6 +106,10 @@ void add_reverse(CLI::App& app, Context& ctx) {
         ro.unit = healed->report.unit;
         ro.product_name = in.stem().string();
         ro.progress = progress;
+        ro.colors = !o->no_colors;
+        ro.segment.tolerance = o->tolerance;
+        ro.segment.surfaces = healed->surfaces;
+        ro.segment.use_surface_indices = !o->no_surfaces;
         auto rev = reverse_to_step(healed->mesh, out, ro);
         if (!rev) {
             // A mesh with nothing to write is the input's fault: name the input.
@@ -76,6 +119,27 @@ void add_reverse(CLI::App& app, Context& ctx) {
             ctx.exit_code =
                 rev.error().code == ErrorCode::kCannotWrite ? kExitCannotWrite : kExitNoResult;
             return;
+        }
+        if (rev->segmentation) {
+            const SegmentResult& seg = *rev->segmentation;
+            if (!o->labels.empty()) {
+                const std::string text =
+                    labels_text(input_labels(healed->mesh, seg, healed->report.input_facets));
+                auto s = write_file_atomic(o->labels, std::as_bytes(std::span(text)));
+                if (!s) {
+                    print_error(s.error().describe());
+                    ctx.exit_code = kExitCannotWrite;
+                    return;
+                }
+            }
+            if (!o->segments.empty()) {
+                auto s = write_file_atomic(o->segments, encode_segments_ply(healed->mesh, seg));
+                if (!s) {
+                    print_error(s.error().describe());
+                    ctx.exit_code = kExitCannotWrite;
+                    return;
+                }
+            }
         }
         const std::string json = to_json(healed->report, *rev);
         if (!o->report.empty()) {
@@ -98,9 +162,13 @@ void add_reverse(CLI::App& app, Context& ctx) {
             return;
         }
         if (!o->json && !o->quiet) {
-            std::fprintf(stderr, "%s: %llu faces, %llu edges, %llu vertices, %s, %llu bytes\n",
+            std::string kinds;
+            for (const auto& [kind, n] : rev->faces_by_kind) {
+                kinds += (kinds.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
+            }
+            std::fprintf(stderr, "%s: %llu faces (%s), %llu edges, %llu vertices, %s, %llu bytes\n",
                          o->output.c_str(), static_cast<unsigned long long>(rev->faces),
-                         static_cast<unsigned long long>(rev->edges),
+                         kinds.c_str(), static_cast<unsigned long long>(rev->edges),
                          static_cast<unsigned long long>(rev->vertices),
                          rev->solid ? "closed solid" : "open shell",
                          static_cast<unsigned long long>(rev->step_bytes));

@@ -22,17 +22,6 @@ struct SegmentCliOptions {
     bool quiet = false;
 };
 
-/// One label per line, in input facet order.
-std::string labels_text(const std::vector<std::int32_t>& labels) {
-    std::string s;
-    s.reserve(labels.size() * 4);
-    for (const std::int32_t l : labels) {
-        s += std::to_string(l);
-        s += '\n';
-    }
-    return s;
-}
-
 void add_segment(CLI::App& app, Context& ctx) {
     auto o = std::make_shared<SegmentCliOptions>();
     CLI::App* cmd = app.add_subcommand(

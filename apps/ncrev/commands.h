@@ -47,6 +47,9 @@ std::function<void(std::string_view stage, double fraction)> terminal_progress(c
 
 /// Prints "error: <message>" to stderr.
 void print_error(const std::string& message);
+
+/// One label per line, in input facet order (`--labels` files).
+std::string labels_text(const std::vector<std::int32_t>& labels);
 /// Prints "warning: <message>" to stderr.
 void print_warning(const std::string& message);
 

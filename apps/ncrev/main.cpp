@@ -41,6 +41,16 @@ std::function<void(std::string_view, double)> terminal_progress(const Context& c
     };
 }
 
+std::string labels_text(const std::vector<std::int32_t>& labels) {
+    std::string s;
+    s.reserve(labels.size() * 4);
+    for (const std::int32_t l : labels) {
+        s += std::to_string(l);
+        s += '\n';
+    }
+    return s;
+}
+
 void print_error(const std::string& message) {
     std::fprintf(stderr, "error: %s\n", message.c_str());
 }

@@ -1,16 +1,43 @@
-// reverse_to_step(): mesh -> B-rep (facets or planar) -> check -> STEP, with the numbers.
+// reverse_to_step(): mesh -> B-rep (facets, planar, or surfaces with the local fallback) ->
+// check -> STEP, with the numbers.
 #include <BRepCheck_Analyzer.hxx>
+#include <BRepGProp.hxx>
+#include <GProp_GProps.hxx>
 #include <Standard_Failure.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
 #include <chrono>
 
+#include "brep/deviation.h"
 #include "brep/planar.h"
 #include "brep/step.h"
+#include "brep/surfaces.h"
 #include "ncrev/brep.h"
 
 namespace ncrev {
 
 const char* to_string(ReverseMethod method) {
-    return method == ReverseMethod::kFacets ? "facets" : "planar";
+    switch (method) {
+        case ReverseMethod::kAuto:
+            return "auto";
+        case ReverseMethod::kSurfaces:
+            return "surfaces";
+        case ReverseMethod::kFacets:
+            return "facets";
+        case ReverseMethod::kPlanar:
+            break;
+    }
+    return "planar";
+}
+
+std::uint32_t kind_color(const std::string& kind) {
+    // Distinct, mid-light colors that read on white and dark backgrounds alike.
+    static const std::map<std::string, std::uint32_t> colors{
+        {"plane", 0xB4BCC8},          {"cylinder", 0x5B9BD5},   {"cone", 0xED7D31},
+        {"sphere", 0x70AD47},         {"torus", 0xFFC000},      {"bspline", 0xC55A9E},
+        {"shear_cylinder", 0x4BACC6}, {"swept_torus", 0xF4B183}};
+    const auto it = colors.find(kind);
+    return it == colors.end() ? 0x9E9E9E : it->second;
 }
 
 const char* to_string(StepSchema schema) {
@@ -33,29 +60,24 @@ constexpr std::uint64_t kOcctCheckMaxFaces = 5000;
 
 }  // namespace
 
-Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::path& output,
-                                      const ReverseOptions& options) {
-    using Clock = std::chrono::steady_clock;
-    ReverseReport rep;
-    rep.method = options.method;
-    if (mesh.num_faces() == 0) {
-        Error e;
-        e.code = ErrorCode::kEmpty;
-        e.path = output.string();
-        e.message = "the mesh has no facet: nothing to write";
-        return e;
-    }
-    auto stage = [&](const char* name, auto&& fn) {
-        if (options.progress) options.progress(name, 0.0);
-        const auto t0 = Clock::now();
-        fn();
-        rep.stage_seconds.emplace_back(name,
-                                       std::chrono::duration<double>(Clock::now() - t0).count());
-        if (options.progress) options.progress(name, 1.0);
-    };
-    const MeshStats stats = compute_stats(mesh);
-    rep.mesh_volume = stats.volume;
-    rep.mesh_area = stats.area;
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Runs fn as the named stage: progress at its start and end, its time in the report.
+template <class F>
+void run_stage(ReverseReport& rep, const ReverseOptions& options, const char* name, F&& fn) {
+    if (options.progress) options.progress(name, 0.0);
+    const auto t0 = Clock::now();
+    fn();
+    rep.stage_seconds.emplace_back(name, std::chrono::duration<double>(Clock::now() - t0).count());
+    if (options.progress) options.progress(name, 1.0);
+}
+
+Result<ReverseReport> reverse_planar(const Mesh& mesh, const MeshStats& stats,
+                                     const std::filesystem::path& output,
+                                     const ReverseOptions& options, ReverseReport rep) {
+    const auto stage = [&](const char* name, auto&& fn) { run_stage(rep, options, name, fn); };
     if (options.planar_tolerance >= 0) {
         rep.planar_tolerance = options.planar_tolerance;
         rep.planar_tolerance_rule = "given by the caller";
@@ -123,6 +145,183 @@ Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::p
     std::error_code ec;
     rep.step_bytes = std::filesystem::file_size(output, ec);
     return rep;
+}
+
+// The most frequent SRE color of each region's facets (-1 where the mesh has none).
+std::vector<std::int64_t> region_colors(const Mesh& mesh, const SegmentResult& seg) {
+    std::vector<std::int64_t> out(seg.regions.size(), -1);
+    if (mesh.colors().empty()) return out;
+    std::vector<std::map<std::int64_t, std::uint64_t>> votes(seg.regions.size());
+    for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
+        ++votes[static_cast<std::size_t>(seg.region[FaceId(f)])][mesh.colors()[f]];
+    }
+    for (std::size_t r = 0; r < votes.size(); ++r) {
+        std::uint64_t best = 0;
+        for (const auto& [color, n] : votes[r]) {
+            if (n > best && color >= 0) {
+                best = n;
+                out[r] = color;
+            }
+        }
+    }
+    return out;
+}
+
+Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
+                                       const std::filesystem::path& output,
+                                       const ReverseOptions& options, ReverseReport rep) {
+    const auto stage = [&](const char* name, auto&& fn) { run_stage(rep, options, name, fn); };
+    // Segmentation (its own stages: curvature for the paper method, segment, fit).
+    Result<SegmentResult> seg = Error{};
+    {
+        const auto t0 = Clock::now();
+        if (options.progress) options.progress("segment", 0.0);
+        seg = segment(mesh, options.segment, options.progress);
+        if (options.progress) options.progress("segment", 1.0);
+        if (!seg) return seg.error();
+        rep.stage_seconds.emplace_back("segment",
+                                       std::chrono::duration<double>(Clock::now() - t0).count());
+    }
+    const SegmentResult& sr = *seg;
+    rep.chordal_deflection = sr.chordal_deflection;
+    std::vector<brep_detail::RegionSurface> surfaces(sr.regions.size());
+    for (std::size_t r = 0; r < sr.regions.size(); ++r) {
+        const Region& g = sr.regions[r];
+        surfaces[r].surface = g.fit.surface;
+        surfaces[r].has_surface = g.fit.ok && g.within_tolerance;
+        if (!g.fit.ok) {
+            surfaces[r].no_surface_reason = "no surface fits the region";
+        } else if (!g.within_tolerance) {
+            surfaces[r].no_surface_reason =
+                std::string("its ") + to_string(g.fit.surface.kind) + " misses vertices by up to " +
+                std::to_string(g.fit.max) + " (tolerance " + std::to_string(sr.tolerance) + ")";
+        }
+    }
+    brep_detail::SurfaceBrepOptions bo;
+    bo.tolerance = sr.tolerance;
+    bo.chordal_deflection = std::max(sr.chordal_deflection, sr.tolerance);
+    bo.allow_fallback = options.method == ReverseMethod::kAuto;
+    brep_detail::SurfaceBrep brep;
+    stage("brep", [&] { brep = brep_detail::build_surface_brep(mesh, sr.region, surfaces, bo); });
+    rep.corners = brep.corners;
+    rep.max_corner_residual = brep.max_corner_residual;
+    rep.max_tolerance = brep.max_tolerance;
+    rep.edges_by_curve = {{"intersection", brep.intersection_edges},
+                          {"fitted", brep.fitted_edges},
+                          {"polyline", brep.polyline_edges}};
+    for (std::size_t r = 0; r < brep.regions.size(); ++r) {
+        const brep_detail::RegionBuild& b = brep.regions[r];
+        if (b.fallback) {
+            ReverseFallback fb;
+            fb.region = static_cast<std::int32_t>(r);
+            fb.facets = sr.regions[r].facets;
+            fb.kind = sr.regions[r].fit.ok ? to_string(sr.regions[r].fit.surface.kind) : "none";
+            fb.reason = b.reason;
+            rep.fallback_faces += b.faces.size();
+            rep.fallbacks.push_back(std::move(fb));
+            rep.faces_by_kind["facet"] += b.faces.size();
+        } else if (!b.faces.empty()) {
+            rep.faces_by_kind[to_string(sr.regions[r].fit.surface.kind)] += b.faces.size();
+        }
+    }
+    rep.solid = brep.solid;
+    rep.valid = brep.valid && brep.solid;
+    rep.occt_checked = !brep.shape.IsNull();
+    if (!brep.shape.IsNull()) {
+        TopTools_IndexedMapOfShape faces, edges, vertices;
+        TopExp::MapShapes(brep.shape, TopAbs_FACE, faces);
+        TopExp::MapShapes(brep.shape, TopAbs_EDGE, edges);
+        TopExp::MapShapes(brep.shape, TopAbs_VERTEX, vertices);
+        rep.faces = static_cast<std::uint64_t>(faces.Extent());
+        rep.edges = static_cast<std::uint64_t>(edges.Extent());
+        rep.vertices = static_cast<std::uint64_t>(vertices.Extent());
+        stage("measure", [&] {
+            GProp_GProps vp, sp;
+            BRepGProp::SurfaceProperties(brep.shape, sp);
+            rep.solid_area = sp.Mass();
+            if (brep.solid) {
+                BRepGProp::VolumeProperties(brep.shape, vp);
+                rep.solid_volume = vp.Mass();
+                if (rep.mesh_volume != 0) {
+                    rep.volume_difference = (rep.solid_volume - rep.mesh_volume) / rep.mesh_volume;
+                }
+            }
+            if (options.measure_deviation && rep.valid) {
+                rep.deviation = brep_detail::measure_deviation(
+                    brep.shape, mesh, 0.25 * std::max(sr.chordal_deflection, sr.tolerance));
+            }
+        });
+    }
+    for (const ReverseFallback& fb : rep.fallbacks) {
+        rep.warnings.push_back("region " + std::to_string(fb.region) + " (" + fb.kind + ", " +
+                               std::to_string(fb.facets) +
+                               " facets) built from its facets: " + fb.reason);
+    }
+    rep.segmentation = std::move(*seg);
+    if (!rep.valid) {
+        rep.warnings.push_back("the B-rep is invalid (" +
+                               (brep.problem.empty() ? std::string("unknown") : brep.problem) +
+                               "): nothing written");
+        return rep;
+    }
+    (void)stats;
+    Status written = Ok{};
+    stage("step", [&] {
+        brep_detail::StepWriteOptions w;
+        w.schema = options.schema;
+        w.unit = options.unit;
+        w.product_name = options.product_name.empty() ? "ncrev" : options.product_name;
+        if (options.colors) {
+            const std::vector<std::int64_t> tool = region_colors(mesh, *rep.segmentation);
+            for (std::size_t r = 0; r < brep.regions.size(); ++r) {
+                const brep_detail::RegionBuild& b = brep.regions[r];
+                const std::uint32_t rgb =
+                    tool[r] >= 0 ? static_cast<std::uint32_t>(tool[r] & 0xFFFFFF)
+                    : b.fallback
+                        ? kind_color("facet")
+                        : kind_color(to_string(rep.segmentation->regions[r].fit.surface.kind));
+                for (const TopoDS_Face& f : b.faces) w.face_colors.emplace_back(f, rgb);
+            }
+        }
+        written = brep_detail::write_step_file(brep.shape, output, w);
+    });
+    if (!written) return written.error();
+    rep.written = true;
+    std::error_code ec;
+    rep.step_bytes = std::filesystem::file_size(output, ec);
+    return rep;
+}
+
+}  // namespace
+
+Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::path& output,
+                                      const ReverseOptions& options) {
+    ReverseReport rep;
+    rep.method = options.method;
+    if (mesh.num_faces() == 0) {
+        Error e;
+        e.code = ErrorCode::kEmpty;
+        e.path = output.string();
+        e.message = "the mesh has no facet: nothing to write";
+        return e;
+    }
+    brep_detail::silence_occt();
+    const MeshStats stats = compute_stats(mesh);
+    rep.mesh_volume = stats.volume;
+    rep.mesh_area = stats.area;
+    const bool surfaces =
+        options.method == ReverseMethod::kAuto || options.method == ReverseMethod::kSurfaces;
+    if (surfaces && stats.closed) return reverse_surfaces(mesh, stats, output, options, rep);
+    if (surfaces) {
+        rep.warnings.push_back(
+            "the mesh is open: its surfaces cannot bound a solid, so it is built with the planar "
+            "method");
+        if (options.method == ReverseMethod::kSurfaces) {
+            rep.warnings.push_back("--method surfaces needs a closed mesh: nothing written");
+            return rep;
+        }
+    }
+    return reverse_planar(mesh, stats, output, options, rep);
 }
 
 }  // namespace ncrev

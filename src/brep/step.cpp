@@ -7,12 +7,20 @@
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <Message_PrinterOStream.hxx>
+#include <Quantity_Color.hxx>
+#include <STEPCAFControl_Writer.hxx>
 #include <STEPControl_Controller.hxx>
 #include <STEPControl_Writer.hxx>
 #include <Standard_Failure.hxx>
 #include <StepBasic_Product.hxx>
 #include <StepData_StepModel.hxx>
 #include <TCollection_HAsciiString.hxx>
+#include <TDF_Label.hxx>
+#include <TDocStd_Document.hxx>
+#include <XCAFApp_Application.hxx>
+#include <XCAFDoc_ColorTool.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
 #include <atomic>
 #include <mutex>
 
@@ -69,28 +77,60 @@ Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& p
         STEPControl_Controller::Init();
         Interface_Static::SetCVal("write.step.schema", schema_name(options.schema));
         Interface_Static::SetCVal("write.step.unit", options.unit == Unit::kInch ? "INCH" : "MM");
-        STEPControl_Writer writer;
-        if (writer.Transfer(shape, STEPControl_AsIs) != IFSelect_RetDone) {
-            return write_error(ErrorCode::kBadValue, path,
-                               "OpenCASCADE could not transfer the shape to STEP");
+        // Header name and time stamp, and the product named as given (OCCT names it "<name>
+        // <process-wide counter>").
+        const auto name_model = [&](const Handle(StepData_StepModel) & model) {
+            APIHeaderSection_MakeHeader header(model);
+            const Handle(TCollection_HAsciiString) name =
+                new TCollection_HAsciiString(options.product_name.c_str());
+            header.SetName(name);
+            if (!options.timestamp.empty()) {
+                header.SetTimeStamp(new TCollection_HAsciiString(options.timestamp.c_str()));
+            }
+            for (int i = 1; i <= model->NbEntities(); ++i) {
+                const Handle(StepBasic_Product) product =
+                    Handle(StepBasic_Product)::DownCast(model->Value(i));
+                if (product.IsNull()) continue;
+                product->SetId(name);
+                product->SetName(name);
+            }
+        };
+        IFSelect_ReturnStatus status = IFSelect_RetFail;
+        if (options.face_colors.empty()) {
+            STEPControl_Writer writer;
+            if (writer.Transfer(shape, STEPControl_AsIs) != IFSelect_RetDone) {
+                return write_error(ErrorCode::kBadValue, path,
+                                   "OpenCASCADE could not transfer the shape to STEP");
+            }
+            name_model(writer.Model());
+            status = writer.Write(tmp.c_str());
+        } else {
+            // Colors need the XDE document: the shape, each colored face a sub-shape label.
+            Handle(TDocStd_Document) doc;
+            XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+            const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+            const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
+            const TDF_Label root = shapes->AddShape(shape, false);
+            for (const auto& [face, rgb] : options.face_colors) {
+                const TDF_Label sub = shapes->AddSubShape(root, face);
+                if (sub.IsNull()) continue;
+                colors->SetColor(
+                    sub,
+                    Quantity_Color(((rgb >> 16) & 0xFF) / 255.0, ((rgb >> 8) & 0xFF) / 255.0,
+                                   (rgb & 0xFF) / 255.0, Quantity_TOC_sRGB),
+                    XCAFDoc_ColorSurf);
+            }
+            STEPCAFControl_Writer writer;
+            writer.SetColorMode(true);
+            writer.SetNameMode(false);
+            if (!writer.Transfer(doc, STEPControl_AsIs)) {
+                return write_error(ErrorCode::kBadValue, path,
+                                   "OpenCASCADE could not transfer the shape to STEP");
+            }
+            name_model(writer.ChangeWriter().Model());
+            status = writer.Write(tmp.c_str());
         }
-        const Handle(StepData_StepModel) model = writer.Model();
-        APIHeaderSection_MakeHeader header(model);
-        const Handle(TCollection_HAsciiString) name =
-            new TCollection_HAsciiString(options.product_name.c_str());
-        header.SetName(name);
-        if (!options.timestamp.empty()) {
-            header.SetTimeStamp(new TCollection_HAsciiString(options.timestamp.c_str()));
-        }
-        // OCCT names the product "<name> <process-wide counter>": use the name alone.
-        for (int i = 1; i <= model->NbEntities(); ++i) {
-            const Handle(StepBasic_Product) product =
-                Handle(StepBasic_Product)::DownCast(model->Value(i));
-            if (product.IsNull()) continue;
-            product->SetId(name);
-            product->SetName(name);
-        }
-        if (writer.Write(tmp.c_str()) != IFSelect_RetDone) {
+        if (status != IFSelect_RetDone) {
             std::error_code ec;
             std::filesystem::remove(tmp, ec);
             return write_error(ErrorCode::kCannotWrite, path,

@@ -2,9 +2,13 @@
 // an atomic write. Internal to the library (OpenCASCADE types allowed).
 #pragma once
 
+#include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
+#include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "ncrev/brep.h"
 #include "ncrev/common.h"
@@ -22,6 +26,9 @@ struct StepWriteOptions {
     /// Header time stamp. Fixed by default so that the same input gives byte-identical STEP
     /// (the house rule on determinism); empty: the current time.
     std::string timestamp = "2000-01-01T00:00:00";
+    /// Face colors (0xRRGGBB, sRGB), written through XDE (STEPCAFControl_Writer) as surface
+    /// styles; empty: plain geometry.
+    std::vector<std::pair<TopoDS_Face, std::uint32_t>> face_colors;
 };
 
 /// Writes `shape` to `path` atomically (a temporary file in the same folder, then a rename).

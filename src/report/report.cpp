@@ -170,6 +170,38 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
                     {"solid_area", rev.solid_area},
                     {"written", rev.written},
                     {"step_bytes", rev.step_bytes}};
+    json& r = j["reverse"];
+    if (rev.segmentation) {
+        const SegmentResult& seg = *rev.segmentation;
+        r["segment"] = {{"method", to_string(seg.method)},
+                        {"tolerance", seg.tolerance},
+                        {"tolerance_rule", seg.tolerance_rule},
+                        {"chordal_deflection", seg.chordal_deflection},
+                        {"given_facets", seg.given_facets}};
+        r["regions"] = seg.regions.size();
+        json fallbacks = json::array();
+        for (const ReverseFallback& f : rev.fallbacks) {
+            fallbacks.push_back({{"region", f.region},
+                                 {"kind", f.kind},
+                                 {"facets", f.facets},
+                                 {"reason", f.reason}});
+        }
+        r["fallbacks"] = fallbacks;
+        r["fallback_faces"] = rev.fallback_faces;
+        r["edges_by_curve"] = rev.edges_by_curve;
+        r["corners"] = rev.corners;
+        r["max_corner_residual"] = rev.max_corner_residual;
+        r["max_tolerance"] = rev.max_tolerance;
+        r["volume_difference"] = rev.volume_difference;
+    }
+    if (rev.deviation) {
+        const auto stats = [](const DistanceStats& d) {
+            return json{{"max", d.max}, {"mean", d.mean}, {"rms", d.rms}, {"points", d.points}};
+        };
+        r["deviation"] = {{"mesh_to_solid", stats(rev.deviation->mesh_to_solid)},
+                          {"solid_to_mesh", stats(rev.deviation->solid_to_mesh)},
+                          {"triangulation_deflection", rev.deviation->deflection}};
+    }
     for (const std::string& w : rev.warnings) j["warnings"].push_back(w);
     return j.dump(indent);
 }

@@ -1,0 +1,18 @@
+// How far a B-rep is from the mesh it was built from, both ways. Internal.
+#pragma once
+
+#include <TopoDS_Shape.hxx>
+
+#include "ncrev/brep.h"
+#include "ncrev/mesh.h"
+
+namespace ncrev::brep_detail {
+
+/// Distances between `shape` and `mesh`: from every mesh vertex to the shape, and from every
+/// node of the shape's own triangulation (BRepMesh at `deflection`, model units) to the mesh.
+/// The shape is approximated by that triangulation, so both figures may exceed the true
+/// distance by up to `deflection`; pass a fraction of the mesh's chordal deflection.
+/// Deterministic whatever the thread count.
+SolidDeviation measure_deviation(const TopoDS_Shape& shape, const Mesh& mesh, double deflection);
+
+}  // namespace ncrev::brep_detail

@@ -1,0 +1,869 @@
+// The exact B-rep from regions and their surfaces (method.md, Step 2b).
+//
+// 1. Borders: region_borders() gives the chains of mesh edges between two regions, corner to
+//    corner (or closed loops), and the corners where three or more regions meet.
+// 2. Vertices: every corner solved onto the surfaces of the regions around it (common_point:
+//    exact where three surfaces cross); a closed loop gets one vertex, solved onto its two.
+// 3. Edges, one per chain, shared by the two faces: the surfaces' intersection (OpenCASCADE's
+//    GeomAPI_IntSS, analytic for elementary pairs) — the branch that runs along the chain,
+//    trimmed at the chain's vertices — where the surfaces cross at a clear angle; where they
+//    are tangent (a fillet and its neighbours: the intersection is ill-conditioned) or the
+//    intersection misses the chain, a curve interpolated through the chain's vertices solved
+//    onto both surfaces. Beside a region built from its facets, the chain's own segments.
+// 4. Faces: each region's surface (its natural normal turned to the solid's outside by the
+//    face orientation, the seam of a periodic surface put opposite the region), bounded by
+//    the loops of its border walked on the mesh; ShapeFix_Face adds the curves on the surface,
+//    missing seams and degenerate edges at poles, within the chordal deflection.
+// 5. Shell and solid, checked with BRepCheck_Analyzer. A region whose face fails (cannot be
+//    built, fails the check, no surface) is built again from its facets — planar triangles
+//    sewn to its neighbours by sharing the chain's segments — and the B-rep is rebuilt.
+#include "brep/surfaces.h"
+
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepCheck.hxx>
+#include <BRepCheck_Analyzer.hxx>
+#include <BRepCheck_Result.hxx>
+#include <BRepLib.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <GeomAPI_IntSS.hxx>
+#include <GeomAPI_Interpolate.hxx>
+#include <GeomAPI_ProjectPointOnCurve.hxx>
+#include <GeomAPI_ProjectPointOnSurf.hxx>
+#include <Geom_BSplineSurface.hxx>
+#include <Geom_Circle.hxx>
+#include <Geom_ConicalSurface.hxx>
+#include <Geom_CylindricalSurface.hxx>
+#include <Geom_OffsetSurface.hxx>
+#include <Geom_Plane.hxx>
+#include <Geom_SphericalSurface.hxx>
+#include <Geom_SurfaceOfLinearExtrusion.hxx>
+#include <Geom_ToroidalSurface.hxx>
+#include <Precision.hxx>
+#include <ShapeBuild_ReShape.hxx>
+#include <ShapeFix_Edge.hxx>
+#include <ShapeFix_Face.hxx>
+#include <Standard_Failure.hxx>
+#include <TColStd_Array1OfInteger.hxx>
+#include <TColStd_Array1OfReal.hxx>
+#include <TColgp_Array2OfPnt.hxx>
+#include <TColgp_HArray1OfPnt.hxx>
+#include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedDataMapOfShapeListOfShape.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Shell.hxx>
+#include <TopoDS_Solid.hxx>
+#include <TopoDS_Vertex.hxx>
+#include <TopoDS_Wire.hxx>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <unordered_map>
+
+#include "ncrev/segment.h"
+
+namespace ncrev::brep_detail {
+
+namespace {
+
+// Smallest tolerance of vertices, edges and faces: OpenCASCADE's Precision::Confusion().
+constexpr double kMinTolerance = 1e-7;
+// Two surfaces meeting at less than this angle (rad, 10 degrees) are treated as tangent: their
+// intersection moves by (surface error) / sin(angle) — 6x at 10 degrees — and OpenCASCADE's
+// intersection of nearly tangent surfaces is unreliable, so the edge is fitted instead.
+constexpr double kTangentAngle = 0.17453292519943295;
+// Points of a chain used to choose and trim an intersection branch (all when fewer).
+constexpr std::size_t kChainSamples = 24;
+// Facet centroids used to find which way a surface's natural normal points.
+constexpr std::size_t kOrientationSamples = 16;
+// Build rounds: each round turns the regions whose faces failed into facets; a failure
+// spreads at most to neighbours, so a few rounds settle.
+constexpr int kMaxRounds = 6;
+
+gp_Pnt pnt(Vec3 v) { return {v.x, v.y, v.z}; }
+Vec3 vec(const gp_Pnt& p) { return {p.X(), p.Y(), p.Z()}; }
+Vec3 vec(const gp_Vec& p) { return {p.X(), p.Y(), p.Z()}; }
+
+Vec3 any_perpendicular(Vec3 a) {
+    const Vec3 t = std::abs(a.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    return normalized(cross(a, t));
+}
+
+// The unit part of `v` perpendicular to the unit `axis`, or any perpendicular when too small.
+Vec3 perpendicular_part(Vec3 v, Vec3 axis) {
+    const Vec3 p = v - dot(v, axis) * axis;
+    const double n = norm(p);
+    return n > 1e-9 * (norm(v) + 1e-300) && n > 0 ? (1.0 / n) * p : any_perpendicular(axis);
+}
+
+// An axis system at `origin`, main direction `z`, x direction from `x_hint` (made
+// perpendicular).
+gp_Ax3 frame(Vec3 origin, Vec3 z, Vec3 x_hint) {
+    const Vec3 x = perpendicular_part(x_hint, z);
+    return gp_Ax3(pnt(origin), gp_Dir(z.x, z.y, z.z), gp_Dir(x.x, x.y, x.z));
+}
+
+// What a region looks like from its facets: area-weighted centroid and outward normal.
+struct RegionShape {
+    Vec3 centroid;
+    Vec3 normal;
+    double area = 0;
+    std::vector<FaceId> samples;  ///< facets spread over the region
+};
+
+// The OpenCASCADE surface of `s`, its seam (or pole) put away from the region: the seam of a
+// cylinder, cone or torus opposite the region's centroid, a sphere's pole at the middle of the
+// region. Null (with `why`) when there is none.
+Handle(Geom_Surface) geom_surface(const Surface& s, const RegionShape& r, std::string& why) {
+    const Vec3 axis = normalized(s.axis);
+    switch (s.kind) {
+        case FitKind::kPlane: {
+            const Vec3 n = dot(axis, r.normal) >= 0 ? axis : -axis;
+            return new Geom_Plane(frame(s.point, n, any_perpendicular(n)));
+        }
+        case FitKind::kCylinder:
+            return new Geom_CylindricalSurface(frame(s.point, axis, s.point - r.centroid),
+                                               s.radius);
+        case FitKind::kCone:
+            return new Geom_ConicalSurface(frame(s.point, axis, s.point - r.centroid), s.angle,
+                                           s.radius);
+        case FitKind::kSphere: {
+            Vec3 pole = r.centroid - s.point;
+            pole = norm(pole) > 1e-9 * s.radius ? normalized(pole) : Vec3{0, 0, 1};
+            return new Geom_SphericalSurface(frame(s.point, pole, any_perpendicular(pole)),
+                                             s.radius);
+        }
+        case FitKind::kTorus:
+            return new Geom_ToroidalSurface(frame(s.point, axis, s.point - r.centroid), s.radius,
+                                            s.minor_radius);
+        case FitKind::kShearCylinder:
+        case FitKind::kSweptTorus: {
+            const gp_Ax2 ax = frame(s.point, axis, any_perpendicular(axis)).Ax2();
+            Handle(Geom_Surface) base = new Geom_SurfaceOfLinearExtrusion(
+                new Geom_Circle(ax, s.radius), gp_Dir(s.sweep.x, s.sweep.y, s.sweep.z));
+            if (s.kind == FitKind::kShearCylinder) return base;
+            // The tube at distance r from the sheared cylinder: the offset side on which the
+            // region's centroid lies.
+            Handle(Geom_Surface) out = new Geom_OffsetSurface(base, s.minor_radius);
+            Handle(Geom_Surface) in = new Geom_OffsetSurface(base, -s.minor_radius);
+            GeomAPI_ProjectPointOnSurf po(pnt(r.centroid), out), pi(pnt(r.centroid), in);
+            const double dout = po.NbPoints() ? po.LowerDistance() : 1e300;
+            const double din = pi.NbPoints() ? pi.LowerDistance() : 1e300;
+            return dout <= din ? out : in;
+        }
+        case FitKind::kBSpline: {
+            if (!s.bspline || s.bspline->num_u < 2 || s.bspline->num_v < 2) {
+                why = "the B-spline surface has no control net";
+                return {};
+            }
+            const BSplineSurface& b = *s.bspline;
+            TColgp_Array2OfPnt poles(1, b.num_u, 1, b.num_v);
+            for (int j = 0; j < b.num_v; ++j) {
+                for (int i = 0; i < b.num_u; ++i) {
+                    poles.SetValue(i + 1, j + 1,
+                                   pnt(b.poles[static_cast<std::size_t>(i + b.num_u * j)]));
+                }
+            }
+            const auto knots = [&](int n, TColStd_Array1OfReal& k, TColStd_Array1OfInteger& m) {
+                const int spans = n - b.degree;
+                k.Resize(1, spans + 1, false);
+                m.Resize(1, spans + 1, false);
+                for (int i = 0; i <= spans; ++i) {
+                    k.SetValue(i + 1, static_cast<double>(i) / spans);
+                    m.SetValue(i + 1, (i == 0 || i == spans) ? b.degree + 1 : 1);
+                }
+            };
+            TColStd_Array1OfReal ku(1, 1), kv(1, 1);
+            TColStd_Array1OfInteger mu(1, 1), mv(1, 1);
+            knots(b.num_u, ku, mu);
+            knots(b.num_v, kv, mv);
+            return new Geom_BSplineSurface(poles, ku, kv, mu, mv, b.degree, b.degree);
+        }
+    }
+    why = "unknown surface kind";
+    return {};
+}
+
+// +1 when the surface's natural normal points out of the solid over the region, -1 when in.
+int natural_sense(const Handle(Geom_Surface) & s, const Mesh& m, const RegionShape& r) {
+    double score = 0;
+    for (FaceId f : r.samples) {
+        const Vec3 n = m.face_normal_area2(f);
+        const Vec3 c = (1.0 / 3) * (m.position(m.vertex(f, 0)) + m.position(m.vertex(f, 1)) +
+                                    m.position(m.vertex(f, 2)));
+        GeomAPI_ProjectPointOnSurf proj(pnt(c), s);
+        if (!proj.NbPoints()) continue;
+        double u = 0, v = 0;
+        proj.LowerDistanceParameters(u, v);
+        gp_Pnt p;
+        gp_Vec du, dv;
+        s->D1(u, v, p, du, dv);
+        score += dot(normalized(vec(du.Crossed(dv))), n);
+    }
+    return score >= 0 ? 1 : -1;
+}
+
+// A chain's curve, oriented along the chain, between parameters first < last.
+struct ChainCurve {
+    Handle(Geom_Curve) curve;
+    double first = 0, last = 0;
+    double deviation = 0;  ///< largest distance of the chain's points from it
+};
+
+// Parameters of `points` on `c`, unwrapped along the chain, or false when a point does not
+// project. The curve is reversed when the chain runs against it.
+bool trim_along(Handle(Geom_Curve) c, const std::vector<gp_Pnt>& points, bool closed,
+                ChainCurve& out) {
+    const bool periodic = c->IsPeriodic() || c->IsClosed();
+    const double period = c->IsPeriodic() ? c->Period() : c->LastParameter() - c->FirstParameter();
+    std::vector<double> u;
+    u.reserve(points.size());
+    double dev = 0;
+    for (const gp_Pnt& p : points) {
+        GeomAPI_ProjectPointOnCurve proj(p, c);
+        if (!proj.NbPoints()) return false;
+        double t = proj.LowerDistanceParameter();
+        dev = std::max(dev, proj.LowerDistance());
+        if (periodic && !u.empty()) {
+            while (t - u.back() > 0.5 * period) t -= period;
+            while (u.back() - t > 0.5 * period) t += period;
+        }
+        u.push_back(t);
+    }
+    double a = u.front(), b = u.back();
+    if (closed) {
+        if (!periodic) return false;
+        // Unwrapped around once: the last point is the first one a period on.
+        if (std::abs(std::abs(b - a) - period) > 0.25 * period) return false;
+        b = a + (b > a ? period : -period);
+    }
+    if (a == b) return false;
+    // Monotone along the chain (a curve that doubles back is the wrong branch).
+    const double sgn = b > a ? 1 : -1;
+    for (std::size_t i = 1; i < u.size(); ++i) {
+        if (sgn * (u[i] - u[i - 1]) < -1e-9 * (std::abs(b - a) + 1)) return false;
+    }
+    if (b < a) {
+        c = c->Reversed();
+        a = c->ReversedParameter(a);
+        b = c->ReversedParameter(b);
+    }
+    out.curve = c;
+    out.first = a;
+    out.last = b;
+    out.deviation = dev;
+    return true;
+}
+
+// Chain points used for choosing and trimming: ends (the solved vertices) and up to
+// kChainSamples spread between.
+std::vector<gp_Pnt> chain_samples(const std::vector<gp_Pnt>& points) {
+    if (points.size() <= kChainSamples) return points;
+    std::vector<gp_Pnt> out;
+    for (std::size_t k = 0; k < kChainSamples; ++k) {
+        out.push_back(points[k * (points.size() - 1) / (kChainSamples - 1)]);
+    }
+    return out;
+}
+
+// The intersection branch of `a` and `b` along `points`, within `accept` of all of them.
+bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surface) & b,
+                        const std::vector<gp_Pnt>& points, bool closed, double accept,
+                        ChainCurve& out) {
+    GeomAPI_IntSS inter(a, b, Precision::Confusion());
+    if (!inter.IsDone()) return false;
+    const std::vector<gp_Pnt> samples = chain_samples(points);
+    bool found = false;
+    for (int i = 1; i <= inter.NbLines(); ++i) {
+        ChainCurve c;
+        if (!trim_along(inter.Line(i), samples, closed, c)) continue;
+        if (c.deviation > accept) continue;
+        if (!found || c.deviation < out.deviation) {
+            out = c;
+            found = true;
+        }
+    }
+    return found;
+}
+
+// A curve through `points` (already on both surfaces), periodic when the chain is closed.
+bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, ChainCurve& out) {
+    std::vector<gp_Pnt> p;
+    for (const gp_Pnt& q : points) {
+        if (p.empty() || p.back().Distance(q) > 10 * kMinTolerance) p.push_back(q);
+    }
+    if (closed && p.size() > 1 && p.back().Distance(p.front()) <= 10 * kMinTolerance) p.pop_back();
+    if (p.size() < (closed ? 3u : 2u)) return false;
+    Handle(TColgp_HArray1OfPnt) arr = new TColgp_HArray1OfPnt(1, static_cast<int>(p.size()));
+    for (std::size_t i = 0; i < p.size(); ++i) arr->SetValue(static_cast<int>(i) + 1, p[i]);
+    GeomAPI_Interpolate interp(arr, closed, kMinTolerance);
+    interp.Perform();
+    if (!interp.IsDone()) return false;
+    out.curve = interp.Curve();
+    out.first = out.curve->FirstParameter();
+    out.last = out.curve->LastParameter();
+    out.deviation = 0;
+    return true;
+}
+
+// The largest distance from the curve to the surfaces, at the midpoints of its spans between
+// the chain's points and at the points themselves.
+double curve_off_surfaces(const ChainCurve& c, const Surface& a, const Surface& b, int samples) {
+    double worst = 0;
+    for (int k = 0; k <= 2 * samples; ++k) {
+        const double t = c.first + (c.last - c.first) * k / (2.0 * samples);
+        const Vec3 p = vec(c.curve->Value(t));
+        worst = std::max({worst, distance(a, p), distance(b, p)});
+    }
+    return worst;
+}
+
+// What BRepCheck_Analyzer finds wrong with `shape`, in words (empty when valid), and the
+// sub-shapes it finds wrong (vertices, edges, wires, faces) in `bad`.
+std::string check_failure(const TopoDS_Shape& shape, std::vector<TopoDS_Shape>* bad = nullptr) {
+    BRepCheck_Analyzer check(shape);
+    if (check.IsValid()) return {};
+    std::string out;
+    for (TopAbs_ShapeEnum type :
+         {TopAbs_VERTEX, TopAbs_EDGE, TopAbs_WIRE, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID}) {
+        TopTools_IndexedMapOfShape subs;
+        TopExp::MapShapes(shape, type, subs);
+        const std::string kind = type == TopAbs_VERTEX  ? "vertex"
+                                 : type == TopAbs_EDGE  ? "edge"
+                                 : type == TopAbs_WIRE  ? "wire"
+                                 : type == TopAbs_FACE  ? "face"
+                                 : type == TopAbs_SHELL ? "shell"
+                                                        : "solid";
+        for (int i = 1; i <= subs.Extent(); ++i) {
+            const Handle(BRepCheck_Result) res = check.Result(subs(i));
+            if (res.IsNull()) continue;
+            std::vector<BRepCheck_Status> statuses(res->Status().begin(), res->Status().end());
+            for (res->InitContextIterator(); res->MoreShapeInContext(); res->NextShapeInContext()) {
+                for (BRepCheck_Status st : res->StatusOnShape()) statuses.push_back(st);
+            }
+            bool wrong = false;
+            for (BRepCheck_Status st : statuses) {
+                if (st == BRepCheck_NoError) continue;
+                wrong = true;
+                std::ostringstream os;
+                BRepCheck::Print(st, os);
+                std::string word = os.str();
+                while (!word.empty() && std::isspace(static_cast<unsigned char>(word.back()))) {
+                    word.pop_back();
+                }
+                const std::string entry = kind + ": " + word;
+                if (out.size() < 300 && out.find(entry) == std::string::npos) {
+                    out += (out.empty() ? "" : "; ") + entry;
+                }
+            }
+            if (wrong && bad) bad->push_back(subs(i));
+        }
+    }
+    return out.empty() ? "invalid" : out;
+}
+
+struct Builder {
+    const Mesh& m;
+    const FaceMap<std::int32_t>& region;
+    std::span<const RegionSurface> surfaces;
+    const SurfaceBrepOptions& opt;
+    RegionBorders borders;
+    std::vector<RegionShape> shapes;
+    // Per half-edge: the chain it lies on (-1 inside a region), and whether it runs along it.
+    std::vector<std::int32_t> he_chain;
+    std::vector<std::uint8_t> he_forward;
+    // Per region: loops of (chain, runs along it).
+    std::vector<std::vector<std::vector<std::pair<std::int32_t, bool>>>> loops;
+
+    Builder(const Mesh& mesh, const FaceMap<std::int32_t>& r, std::span<const RegionSurface> s,
+            const SurfaceBrepOptions& o)
+        : m(mesh), region(r), surfaces(s), opt(o) {}
+
+    void prepare() {
+        borders = region_borders(m, region);
+        const std::size_t nr = surfaces.size();
+        shapes.assign(nr, {});
+        std::vector<std::vector<FaceId>> faces(nr);
+        for (std::uint32_t f = 0; f < m.num_faces(); ++f) {
+            const FaceId id(f);
+            const auto r = static_cast<std::size_t>(region[id]);
+            const Vec3 n2 = m.face_normal_area2(id);
+            const double a = 0.5 * norm(n2);
+            const Vec3 c = (1.0 / 3) * (m.position(m.vertex(id, 0)) + m.position(m.vertex(id, 1)) +
+                                        m.position(m.vertex(id, 2)));
+            shapes[r].centroid = shapes[r].centroid + a * c;
+            shapes[r].normal = shapes[r].normal + 0.5 * n2;
+            shapes[r].area += a;
+            faces[r].push_back(id);
+        }
+        for (std::size_t r = 0; r < nr; ++r) {
+            RegionShape& s = shapes[r];
+            if (s.area > 0) s.centroid = (1.0 / s.area) * s.centroid;
+            if (norm(s.normal) > 0) s.normal = normalized(s.normal);
+            const std::size_t n = faces[r].size();
+            const std::size_t k = std::min(n, kOrientationSamples);
+            for (std::size_t i = 0; i < k; ++i) s.samples.push_back(faces[r][i * n / k]);
+        }
+        he_chain.assign(m.num_halfedges(), -1);
+        he_forward.assign(m.num_halfedges(), 0);
+        for (std::size_t c = 0; c < borders.chains.size(); ++c) {
+            const auto& vs = borders.chains[c].vertices;
+            for (std::size_t k = 0; k + 1 < vs.size(); ++k) {
+                m.for_each_outgoing(vs[k], [&](HalfedgeId h) {
+                    if (m.target(h) != vs[k + 1]) return;
+                    he_chain[h.idx()] = static_cast<std::int32_t>(c);
+                    he_forward[h.idx()] = 1;
+                    const HalfedgeId t = m.twin(h);
+                    if (t.is_valid()) he_chain[t.idx()] = static_cast<std::int32_t>(c);
+                });
+            }
+        }
+        // Loops: each region's border half-edges walked with the region on the left.
+        loops.assign(nr, {});
+        std::vector<std::uint8_t> seen(m.num_halfedges(), 0);
+        for (std::uint32_t hi = 0; hi < m.num_halfedges(); ++hi) {
+            if (seen[hi] || he_chain[hi] < 0) continue;
+            const HalfedgeId h0(hi);
+            const std::int32_t r = region[Mesh::face(h0)];
+            std::vector<std::uint32_t> walk;
+            HalfedgeId h = h0;
+            do {
+                seen[h.idx()] = 1;
+                walk.push_back(h.idx());
+                // The next border half-edge of r around the target vertex.
+                HalfedgeId n = Mesh::next(h);
+                while (he_chain[n.idx()] < 0) n = Mesh::next(m.twin(n));
+                h = n;
+            } while (h != h0 && walk.size() <= m.num_halfedges());
+            // Start the loop where a chain starts: after a change of chain (a single closed
+            // chain has none).
+            std::size_t start = 0;
+            for (std::size_t i = 0; i < walk.size(); ++i) {
+                const std::size_t p = (i + walk.size() - 1) % walk.size();
+                if (he_chain[walk[i]] != he_chain[walk[p]]) {
+                    start = i;
+                    break;
+                }
+            }
+            std::vector<std::pair<std::int32_t, bool>> loop;
+            for (std::size_t i = 0; i < walk.size(); ++i) {
+                const std::uint32_t w = walk[(start + i) % walk.size()];
+                if (loop.empty() || loop.back().first != he_chain[w]) {
+                    loop.emplace_back(he_chain[w], he_forward[w] != 0);
+                }
+            }
+            loops[static_cast<std::size_t>(r)].push_back(std::move(loop));
+        }
+    }
+};
+
+}  // namespace
+
+SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& region,
+                               std::span<const RegionSurface> regions,
+                               const SurfaceBrepOptions& opt) {
+    SurfaceBrep out;
+    const std::size_t nr = regions.size();
+    out.regions.assign(nr, {});
+    Builder bd(m, region, regions, opt);
+    bd.prepare();
+    const RegionBorders& borders = bd.borders;
+    const double max_tol = std::max(opt.chordal_deflection, 10 * opt.tolerance);
+
+    // Geometry of every region; a region without one is built from its facets.
+    std::vector<Handle(Geom_Surface)> geom(nr);
+    std::vector<int> sense(nr, 1);
+    std::vector<std::uint8_t> fallback(nr, 0);
+    const auto fall_back = [&](std::size_t r, std::string why) {
+        if (fallback[r]) return;
+        fallback[r] = 1;
+        out.regions[r].fallback = true;
+        out.regions[r].reason = std::move(why);
+    };
+    for (std::size_t r = 0; r < nr; ++r) {
+        if (!regions[r].has_surface) {
+            fall_back(r, regions[r].no_surface_reason.empty() ? "no surface fits the region"
+                                                              : regions[r].no_surface_reason);
+            continue;
+        }
+        std::string why;
+        try {
+            geom[r] = geom_surface(regions[r].surface, bd.shapes[r], why);
+            if (!geom[r].IsNull()) sense[r] = natural_sense(geom[r], m, bd.shapes[r]);
+        } catch (const Standard_Failure& f) {
+            geom[r].Nullify();
+            why = std::string("OpenCASCADE cannot make the surface: ") + f.GetMessageString();
+        }
+        if (geom[r].IsNull()) fall_back(r, "no OpenCASCADE surface: " + why);
+        if (!fallback[r] && bd.loops[r].empty() && regions[r].surface.kind != FitKind::kSphere &&
+            regions[r].surface.kind != FitKind::kTorus) {
+            fall_back(r, "a region without a border on an open surface");
+        }
+    }
+    if (!opt.allow_fallback) {
+        for (std::size_t r = 0; r < nr; ++r) {
+            if (fallback[r]) {
+                out.problem = "region " + std::to_string(r) + ": " + out.regions[r].reason;
+                return out;
+            }
+        }
+    }
+
+    // Regions around every mesh vertex that is a corner or a loop's start.
+    const auto regions_at = [&](VertexId v) {
+        std::vector<std::int32_t> rs;
+        m.for_each_outgoing(v, [&](HalfedgeId h) { rs.push_back(region[Mesh::face(h)]); });
+        std::sort(rs.begin(), rs.end());
+        rs.erase(std::unique(rs.begin(), rs.end()), rs.end());
+        return rs;
+    };
+
+    BRep_Builder B;
+    for (int round = 1; round <= kMaxRounds; ++round) {
+        out.rounds = round;
+        out.intersection_edges = out.fitted_edges = out.polyline_edges = 0;
+        out.corners = 0;
+        out.max_corner_residual = 0;
+        // 2. Vertices: solved corners (and loop starts); other mesh vertices at their place.
+        std::unordered_map<std::uint32_t, TopoDS_Vertex> vertex;
+        const auto solved_vertex = [&](VertexId v) -> TopoDS_Vertex {
+            auto it = vertex.find(v.idx());
+            if (it != vertex.end()) return it->second;
+            std::vector<Surface> on;
+            for (std::int32_t r : regions_at(v)) {
+                if (!fallback[static_cast<std::size_t>(r)]) {
+                    on.push_back(regions[static_cast<std::size_t>(r)].surface);
+                }
+            }
+            Vec3 p = m.position(v);
+            double tol = kMinTolerance;
+            if (!on.empty()) {
+                const CommonPoint cp = common_point(on, p);
+                if (cp.residual <= opt.tolerance && norm(cp.point - p) <= max_tol) {
+                    p = cp.point;
+                    tol = std::max(tol, 1.01 * cp.residual);
+                    out.max_corner_residual = std::max(out.max_corner_residual, cp.residual);
+                } else {
+                    // Unsolved (surfaces nearly tangent, or a bad fit): the mesh vertex, with
+                    // the tolerance that reaches every surface.
+                    double d = 0;
+                    for (const Surface& s : on) d = std::max(d, distance(s, p));
+                    tol = std::max(tol, 1.01 * d);
+                    out.max_corner_residual = std::max(out.max_corner_residual, d);
+                }
+                ++out.corners;
+            }
+            TopoDS_Vertex V;
+            B.MakeVertex(V, pnt(p), tol);
+            vertex.emplace(v.idx(), V);
+            return V;
+        };
+        const auto plain_vertex = [&](VertexId v) -> TopoDS_Vertex {
+            auto it = vertex.find(v.idx());
+            if (it != vertex.end()) return it->second;
+            TopoDS_Vertex V;
+            B.MakeVertex(V, pnt(m.position(v)), kMinTolerance);
+            vertex.emplace(v.idx(), V);
+            return V;
+        };
+        for (VertexId c : borders.corners) solved_vertex(c);
+        // Straight segment edges between mesh vertices, shared (key: the two vertex ids).
+        std::unordered_map<std::uint64_t, TopoDS_Edge> segment;
+        const auto segment_edge = [&](VertexId a, VertexId b, bool& forward) -> TopoDS_Edge {
+            const std::uint32_t lo = std::min(a.idx(), b.idx()), hi = std::max(a.idx(), b.idx());
+            forward = a.idx() == lo;
+            const std::uint64_t key = (std::uint64_t{lo} << 32) | hi;
+            auto it = segment.find(key);
+            if (it != segment.end()) return it->second;
+            const TopoDS_Vertex va = plain_vertex(VertexId(lo)), vb = plain_vertex(VertexId(hi));
+            BRepBuilderAPI_MakeEdge me(va, vb);
+            TopoDS_Edge e = me.IsDone() ? me.Edge() : TopoDS_Edge();
+            segment.emplace(key, e);
+            return e;
+        };
+
+        // 3. Edges: per chain, its edges in chain order, each running along the chain.
+        std::vector<std::vector<TopoDS_Edge>> chain_edges(borders.chains.size());
+        std::vector<std::int32_t> failed_chain;
+        for (std::size_t c = 0; c < borders.chains.size(); ++c) {
+            const BorderChain& ch = borders.chains[c];
+            const auto ra = static_cast<std::size_t>(ch.left);
+            const bool boundary = ch.right < 0;
+            const auto rb = boundary ? ra : static_cast<std::size_t>(ch.right);
+            const VertexId v0 = ch.vertices.front(), v1 = ch.vertices.back();
+            const bool polyline = boundary || fallback[ra] || fallback[rb];
+            if (!polyline) {
+                const TopoDS_Vertex V0 = solved_vertex(v0);
+                const TopoDS_Vertex V1 = ch.closed ? V0 : solved_vertex(v1);
+                const Surface& sa = regions[ra].surface;
+                const Surface& sb = regions[rb].surface;
+                // The chain's points: the solved ends, the interior vertices solved onto both.
+                std::vector<gp_Pnt> pts;
+                pts.reserve(ch.vertices.size());
+                const std::array<Surface, 2> pair{sa, sb};
+                double min_sin = 1;
+                for (std::size_t k = 0; k < ch.vertices.size(); ++k) {
+                    const bool end = k == 0 || k + 1 == ch.vertices.size();
+                    if (end) {
+                        pts.push_back(BRep_Tool::Pnt(k == 0 ? V0 : V1));
+                    } else {
+                        pts.push_back(pnt(common_point(pair, m.position(ch.vertices[k])).point));
+                    }
+                    const Vec3 p = vec(pts.back());
+                    min_sin = std::min(min_sin, norm(cross(normal_at(sa, p), normal_at(sb, p))));
+                }
+                ChainCurve cc;
+                bool ok = false, intersected = false;
+                try {
+                    if (min_sin > std::sin(kTangentAngle)) {
+                        ok = intersection_curve(geom[ra], geom[rb], pts, ch.closed,
+                                                opt.chordal_deflection + opt.tolerance, cc);
+                        intersected = ok;
+                    }
+                    if (!ok && fitted_curve(pts, ch.closed, cc)) {
+                        // Its tolerance: how far it strays from the two surfaces.
+                        cc.deviation =
+                            curve_off_surfaces(cc, sa, sb, static_cast<int>(ch.vertices.size()));
+                        ok = cc.deviation <= max_tol;
+                    }
+                    if (ok) {
+                        // The vertices reach the curve's ends.
+                        const gp_Pnt e0 = cc.curve->Value(cc.first), e1 = cc.curve->Value(cc.last);
+                        B.UpdateVertex(V0, std::max(BRep_Tool::Tolerance(V0),
+                                                    1.01 * e0.Distance(BRep_Tool::Pnt(V0))));
+                        B.UpdateVertex(V1, std::max(BRep_Tool::Tolerance(V1),
+                                                    1.01 * e1.Distance(BRep_Tool::Pnt(V1))));
+                        BRepBuilderAPI_MakeEdge me(cc.curve, V0, V1, cc.first, cc.last);
+                        ok = me.IsDone();
+                        if (ok) {
+                            TopoDS_Edge e = me.Edge();
+                            B.UpdateEdge(e, std::max(kMinTolerance, 1.01 * cc.deviation));
+                            chain_edges[c].push_back(e);
+                            ++(intersected ? out.intersection_edges : out.fitted_edges);
+                        }
+                    }
+                } catch (const Standard_Failure&) {
+                    ok = false;
+                }
+                if (ok) continue;
+                failed_chain.push_back(static_cast<std::int32_t>(c));
+            }
+            // The chain's own segments.
+            for (std::size_t k = 0; k + 1 < ch.vertices.size(); ++k) {
+                bool fwd = true;
+                TopoDS_Edge e = segment_edge(ch.vertices[k], ch.vertices[k + 1], fwd);
+                chain_edges[c].push_back(
+                    TopoDS::Edge(e.Oriented(fwd ? TopAbs_FORWARD : TopAbs_REVERSED)));
+            }
+            ++out.polyline_edges;
+        }
+        // A chain without a curve between two surfaces: both regions become facets, since
+        // a polyline edge may lie off a curved surface by more than its tolerance allows.
+        bool changed = false;
+        for (std::int32_t c : failed_chain) {
+            const BorderChain& ch = borders.chains[static_cast<std::size_t>(c)];
+            for (std::int32_t r : {ch.left, ch.right}) {
+                if (r < 0 || fallback[static_cast<std::size_t>(r)]) continue;
+                fall_back(static_cast<std::size_t>(r),
+                          "no edge curve with region " +
+                              std::to_string(r == ch.left ? ch.right : ch.left));
+                changed = true;
+            }
+        }
+        if (changed) {
+            if (!opt.allow_fallback) break;
+            continue;
+        }
+
+        // 4. Faces.
+        Handle(ShapeBuild_ReShape) context = new ShapeBuild_ReShape;
+        std::vector<std::vector<TopoDS_Face>> faces(nr);
+        std::vector<std::pair<std::size_t, std::string>> failed_region;
+        for (std::size_t r = 0; r < nr; ++r) {
+            if (fallback[r]) continue;
+            try {
+                TopoDS_Face F;
+                if (bd.loops[r].empty()) {
+                    BRepBuilderAPI_MakeFace mf(geom[r], Precision::Confusion());
+                    if (!mf.IsDone()) throw Standard_Failure("natural bounds");
+                    F = mf.Face();
+                } else {
+                    B.MakeFace(F, geom[r], kMinTolerance);
+                    for (const auto& loop : bd.loops[r]) {
+                        // The loop, in the surface's own orientation.
+                        std::vector<TopoDS_Edge> wire_edges;
+                        for (const auto& [c, fwd] : loop) {
+                            const auto& es = chain_edges[static_cast<std::size_t>(c)];
+                            if (fwd) {
+                                for (const TopoDS_Edge& e : es) wire_edges.push_back(e);
+                            } else {
+                                for (auto it = es.rbegin(); it != es.rend(); ++it) {
+                                    wire_edges.push_back(TopoDS::Edge(it->Reversed()));
+                                }
+                            }
+                        }
+                        if (sense[r] < 0) {
+                            std::reverse(wire_edges.begin(), wire_edges.end());
+                            for (TopoDS_Edge& e : wire_edges) e.Reverse();
+                        }
+                        TopoDS_Wire W;
+                        B.MakeWire(W);
+                        for (const TopoDS_Edge& e : wire_edges) B.Add(W, e);
+                        W.Closed(true);
+                        B.Add(F, W);
+                    }
+                    ShapeFix_Face fix(F);
+                    fix.SetContext(context);
+                    fix.SetPrecision(kMinTolerance);
+                    fix.SetMinTolerance(kMinTolerance);
+                    fix.SetMaxTolerance(max_tol);
+                    fix.Perform();
+                    F = fix.Face();
+                    // Edges the fix added or changed (seams, split edges) get their parameter
+                    // ranges and tolerances made consistent with their curves on the surface.
+                    for (TopExp_Explorer x(F, TopAbs_EDGE); x.More(); x.Next()) {
+                        ShapeFix_Edge().FixSameParameter(TopoDS::Edge(x.Current()));
+                    }
+                }
+                if (sense[r] < 0) F.Reverse();
+                if (std::string why = check_failure(F); !why.empty()) {
+                    failed_region.emplace_back(r,
+                                               "its face fails OpenCASCADE's check (" + why + ")");
+                    continue;
+                }
+                faces[r].push_back(F);
+            } catch (const Standard_Failure& f) {
+                failed_region.emplace_back(
+                    r, std::string("OpenCASCADE fails building its face: ") + f.GetMessageString());
+            }
+        }
+        // Facet faces of the fallback regions.
+        for (std::size_t r = 0; r < nr; ++r) {
+            if (!fallback[r]) continue;
+        }
+        for (std::uint32_t fi = 0; fi < m.num_faces(); ++fi) {
+            const FaceId f(fi);
+            const auto r = static_cast<std::size_t>(region[f]);
+            if (!fallback[r]) continue;
+            TopoDS_Wire W;
+            B.MakeWire(W);
+            for (int i = 0; i < 3; ++i) {
+                const HalfedgeId h = m.halfedge(f, i);
+                bool fwd = true;
+                TopoDS_Edge e = segment_edge(m.origin(h), m.target(h), fwd);
+                B.Add(W, e.Oriented(fwd ? TopAbs_FORWARD : TopAbs_REVERSED));
+            }
+            W.Closed(true);
+            const gp_Pnt p0 = BRep_Tool::Pnt(plain_vertex(m.vertex(f, 0)));
+            const gp_Pnt p1 = BRep_Tool::Pnt(plain_vertex(m.vertex(f, 1)));
+            const gp_Pnt p2 = BRep_Tool::Pnt(plain_vertex(m.vertex(f, 2)));
+            const gp_Vec n = gp_Vec(p0, p1).Crossed(gp_Vec(p0, p2));
+            if (n.Magnitude() <= 0) continue;
+            TopoDS_Face F;
+            B.MakeFace(F, new Geom_Plane(p0, gp_Dir(n)), kMinTolerance);
+            B.Add(F, W);
+            faces[r].push_back(F);
+        }
+        if (!failed_region.empty()) {
+            if (!opt.allow_fallback) {
+                out.problem = "region " + std::to_string(failed_region.front().first) + ": " +
+                              failed_region.front().second;
+                return out;
+            }
+            for (auto& [r, why] : failed_region) fall_back(r, std::move(why));
+            continue;
+        }
+
+        // 5. Shell and solid.
+        TopoDS_Shell shell;
+        B.MakeShell(shell);
+        for (std::size_t r = 0; r < nr; ++r) {
+            for (const TopoDS_Face& f : faces[r]) B.Add(shell, f);
+        }
+        const TopoDS_Shape fixed = context->Apply(shell);
+        TopTools_IndexedDataMapOfShapeListOfShape edge_faces;
+        TopExp::MapShapesAndUniqueAncestors(fixed, TopAbs_EDGE, TopAbs_FACE, edge_faces);
+        bool closed = true;
+        for (int i = 1; i <= edge_faces.Extent(); ++i) {
+            const TopoDS_Edge& e = TopoDS::Edge(edge_faces.FindKey(i));
+            if (BRep_Tool::Degenerated(e)) continue;
+            const int n = edge_faces.FindFromIndex(i).Extent();
+            if (n == 2) continue;
+            if (n == 1 && BRep_Tool::IsClosed(e, TopoDS::Face(edge_faces.FindFromIndex(i).First())))
+                continue;
+            closed = false;
+        }
+        for (std::size_t r = 0; r < nr; ++r) {
+            out.regions[r].faces.clear();
+            for (const TopoDS_Face& f : faces[r]) {
+                out.regions[r].faces.push_back(TopoDS::Face(context->Value(f)));
+            }
+        }
+        // Every edge now has its curves on both faces: make them agree (same range, same
+        // parameter), with the tolerance that takes.
+        for (TopExp_Explorer x(fixed, TopAbs_EDGE); x.More(); x.Next()) {
+            ShapeFix_Edge().FixSameParameter(TopoDS::Edge(x.Current()));
+        }
+        TopoDS_Shape result = fixed;
+        if (closed) {
+            TopoDS_Shell sh = TopoDS::Shell(fixed);
+            sh.Closed(true);
+            TopoDS_Solid solid;
+            B.MakeSolid(solid);
+            B.Add(solid, sh);
+            result = solid;
+        }
+        out.shape = result;
+        out.solid = closed;
+        std::vector<TopoDS_Shape> bad;
+        const std::string why = check_failure(result, &bad);
+        out.valid = why.empty() && closed;
+        if (!why.empty()) out.problem = "BRepCheck_Analyzer: " + why;
+        if (!closed) out.problem = "the shell is not closed";
+        if (out.valid || !opt.allow_fallback) break;
+        // The regions whose faces hold what the check finds wrong become facets.
+        TopTools_IndexedMapOfShape bad_faces;
+        for (const TopoDS_Shape& b : bad) {
+            if (b.ShapeType() == TopAbs_FACE) {
+                bad_faces.Add(b);
+                continue;
+            }
+            TopTools_IndexedDataMapOfShapeListOfShape anc;
+            TopExp::MapShapesAndUniqueAncestors(result, b.ShapeType(), TopAbs_FACE, anc);
+            const int i = anc.FindIndex(b);
+            if (i == 0) continue;
+            for (const TopoDS_Shape& f : anc.FindFromIndex(i)) bad_faces.Add(f);
+        }
+        bool more = false;
+        for (std::size_t r = 0; r < nr; ++r) {
+            if (fallback[r]) continue;
+            for (const TopoDS_Face& f : out.regions[r].faces) {
+                if (bad_faces.Contains(f) || bad_faces.Contains(f.Reversed())) {
+                    fall_back(r, "the solid fails OpenCASCADE's check at its face (" + why + ")");
+                    more = true;
+                    break;
+                }
+            }
+        }
+        if (!more) break;
+    }
+    // Largest tolerance.
+    if (!out.shape.IsNull()) {
+        for (TopExp_Explorer x(out.shape, TopAbs_VERTEX); x.More(); x.Next()) {
+            out.max_tolerance =
+                std::max(out.max_tolerance, BRep_Tool::Tolerance(TopoDS::Vertex(x.Current())));
+        }
+        for (TopExp_Explorer x(out.shape, TopAbs_EDGE); x.More(); x.Next()) {
+            out.max_tolerance =
+                std::max(out.max_tolerance, BRep_Tool::Tolerance(TopoDS::Edge(x.Current())));
+        }
+    }
+    return out;
+}
+
+}  // namespace ncrev::brep_detail

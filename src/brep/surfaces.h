@@ -1,0 +1,64 @@
+// The exact B-rep from regions and their surfaces (../shared/docs/method.md, Step 2b). Internal.
+#pragma once
+
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Shape.hxx>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "ncrev/fit.h"
+#include "ncrev/mesh.h"
+
+namespace ncrev::brep_detail {
+
+/// One region of the labelling: its surface, or none (`has_surface` false: the region can only
+/// be built from its facets).
+struct RegionSurface {
+    Surface surface;
+    bool has_surface = false;
+    std::string no_surface_reason;  ///< why not, when `has_surface` is false
+};
+
+struct SurfaceBrepOptions {
+    /// Largest distance of the mesh vertices from their region's surface (the segmentation
+    /// tolerance), model units: corners and edges are accepted on their surfaces within it.
+    double tolerance = 0;
+    /// The mesh's chordal deflection: the largest tolerance an edge or vertex may be given (an
+    /// edge fitted to a chain, a polyline edge beside a fallback region).
+    double chordal_deflection = 0;
+    /// A region whose face cannot be built comes back as its facets (true), or the build fails.
+    bool allow_fallback = true;
+};
+
+/// What happened to one region.
+struct RegionBuild {
+    bool fallback = false;           ///< built as its facets
+    std::string reason;              ///< why, when `fallback`
+    std::vector<TopoDS_Face> faces;  ///< the faces it became (one, or its facets)
+};
+
+struct SurfaceBrep {
+    TopoDS_Shape shape;  ///< a solid when `solid`, else the shell
+    bool solid = false;
+    bool valid = false;   ///< BRepCheck_Analyzer found no defect
+    std::string problem;  ///< what is wrong when not valid
+    std::vector<RegionBuild> regions;
+    /// Edges by how their curve was made: "intersection" (OpenCASCADE's surface intersection,
+    /// analytic for elementary pairs), "fitted" (a curve through the chain's points solved onto
+    /// both surfaces: tangent junctions, failed intersections), "polyline" (beside a fallback).
+    std::uint64_t intersection_edges = 0, fitted_edges = 0, polyline_edges = 0;
+    std::uint64_t corners = 0;
+    double max_corner_residual = 0;  ///< largest distance of a solved corner from its surfaces
+    double max_tolerance = 0;        ///< largest vertex / edge / face tolerance of the result
+    int rounds = 0;                  ///< build rounds (each one after new fallbacks)
+};
+
+/// Builds the B-rep of the closed, outward-oriented `mesh` whose face f belongs to region
+/// `region[f]` (0 <= region[f] < regions.size()). Never throws.
+SurfaceBrep build_surface_brep(const Mesh& mesh, const FaceMap<std::int32_t>& region,
+                               std::span<const RegionSurface> regions,
+                               const SurfaceBrepOptions& options);
+
+}  // namespace ncrev::brep_detail
