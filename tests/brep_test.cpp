@@ -23,6 +23,7 @@
 #include <fstream>
 
 #include "ncrev/sample.h"
+#include "step_readback.h"
 #include "test_meshes.h"
 
 namespace ncrev {
@@ -59,30 +60,6 @@ std::size_t count_faces(const TopoDS_Shape& s) {
     return static_cast<std::size_t>(faces.Extent());
 }
 
-struct ReadBack {
-    TopoDS_Shape shape;
-    bool valid = false;
-    std::size_t solids = 0, faces = 0;
-    double volume = 0;
-};
-
-ReadBack read_step(const std::filesystem::path& path) {
-    ReadBack r;
-    STEPControl_Reader reader;
-    if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) return r;
-    reader.TransferRoots();
-    r.shape = reader.OneShape();
-    r.valid = BRepCheck_Analyzer(r.shape).IsValid();
-    TopTools_IndexedMapOfShape solids;
-    TopExp::MapShapes(r.shape, TopAbs_SOLID, solids);
-    r.solids = static_cast<std::size_t>(solids.Extent());
-    r.faces = count_faces(r.shape);
-    GProp_GProps props;
-    BRepGProp::VolumeProperties(r.shape, props);
-    r.volume = props.Mass();
-    return r;
-}
-
 std::filesystem::path out_dir() {
     static const auto dir = [] {
         auto d = std::filesystem::temp_directory_path() /
@@ -100,8 +77,8 @@ Mesh heal(TriangleSoup soup) {
 }
 
 /// Builds with `method`, writes, reads back, checks validity, closure and volume.
-ReadBack round_trip(const Mesh& mesh, ReverseMethod method, const std::string& name,
-                    double volume_rel) {
+test::ReadBack round_trip(const Mesh& mesh, ReverseMethod method, const std::string& name,
+                          double volume_rel) {
     ReverseOptions o;
     o.method = method;
     const auto path = out_dir() / (name + "_" + to_string(method) + ".step");
@@ -112,7 +89,7 @@ ReadBack round_trip(const Mesh& mesh, ReverseMethod method, const std::string& n
     EXPECT_TRUE(rev->solid) << name;
     EXPECT_TRUE(rev->written) << name;
     EXPECT_NEAR(rev->solid_volume, rev->mesh_volume, volume_rel * rev->mesh_volume) << name;
-    ReadBack back = read_step(path);
+    test::ReadBack back = test::read_step(path);
     EXPECT_TRUE(back.valid) << name;
     EXPECT_EQ(back.solids, 1u) << name;
     EXPECT_EQ(back.faces, rev->faces) << name;
@@ -150,7 +127,7 @@ TEST(ReversePlanar, PrismaticPartsComeBackWithTheirTrueFaces) {
     for (const PlanarPart& p : planar_parts()) {
         const Mesh mesh = heal(tessellate(p.shape, 0.1));
         ASSERT_TRUE(compute_stats(mesh).closed) << p.name;
-        const ReadBack back = round_trip(mesh, ReverseMethod::kPlanar, p.name, 1e-7);
+        const test::ReadBack back = round_trip(mesh, ReverseMethod::kPlanar, p.name, 1e-7);
         EXPECT_EQ(back.faces, count_faces(p.shape)) << p.name;
     }
 }
@@ -158,7 +135,7 @@ TEST(ReversePlanar, PrismaticPartsComeBackWithTheirTrueFaces) {
 TEST(ReverseFacets, OneFacePerFacetAndTheMeshVolume) {
     for (const PlanarPart& p : planar_parts()) {
         const Mesh mesh = heal(tessellate(p.shape, 0.1));
-        const ReadBack back = round_trip(mesh, ReverseMethod::kFacets, p.name, 1e-9);
+        const test::ReadBack back = round_trip(mesh, ReverseMethod::kFacets, p.name, 1e-9);
         EXPECT_EQ(back.faces, mesh.num_faces()) << p.name;
     }
 }
@@ -172,7 +149,7 @@ TEST(Reverse, SamplePartsWithCurvedFacesGiveValidSolidsWithBothMethods) {
         ASSERT_TRUE(part.ok()) << part.error().describe();
         const Mesh mesh = heal(part->mesh);
         round_trip(mesh, ReverseMethod::kFacets, name, 1e-9);
-        const ReadBack planar = round_trip(mesh, ReverseMethod::kPlanar, name, 1e-7);
+        const test::ReadBack planar = round_trip(mesh, ReverseMethod::kPlanar, name, 1e-7);
         EXPECT_LT(planar.faces, mesh.num_faces()) << name;  // flat faces merged
     }
 }
@@ -188,7 +165,7 @@ TEST(Reverse, OpenMeshGivesAShellAndAWarning) {
     EXPECT_TRUE(rev->written);
     ASSERT_FALSE(rev->warnings.empty());
     EXPECT_NE(rev->warnings[0].find("open"), std::string::npos);
-    const ReadBack back = read_step(path);
+    const test::ReadBack back = test::read_step(path);
     EXPECT_EQ(back.solids, 0u);
     EXPECT_GT(back.faces, 0u);
 }
@@ -231,14 +208,14 @@ TEST(Reverse, InchUnitAndOtherSchemasReadBackAsTheSameSolid) {
     const std::string text(std::istreambuf_iterator<char>(in), {});
     EXPECT_NE(text.find("AP242_MANAGED_MODEL_BASED_3D_ENGINEERING"), std::string::npos);
     EXPECT_NE(text.find("CONVERSION_BASED_UNIT('INCH'"), std::string::npos);
-    const ReadBack back = read_step(path);  // OpenCASCADE converts to mm
+    const test::ReadBack back = test::read_step(path);  // OpenCASCADE converts to mm
     EXPECT_TRUE(back.valid);
     EXPECT_NEAR(back.volume, 25.4 * 25.4 * 25.4, 1e-6);
     o.unit = Unit::kMillimetre;
     o.schema = StepSchema::kAP203;
     const auto path203 = out_dir() / "cube203.step";
     ASSERT_TRUE(reverse_to_step(mesh, path203, o).ok());
-    const ReadBack b203 = read_step(path203);
+    const test::ReadBack b203 = test::read_step(path203);
     EXPECT_TRUE(b203.valid);
     EXPECT_NEAR(b203.volume, 1.0, 1e-12);
 }

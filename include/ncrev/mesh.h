@@ -153,6 +153,9 @@ struct HealReport {
     std::uint64_t welded_vertices = 0;      ///< distinct vertices merged by the tolerance weld
     std::uint64_t unreferenced_vertices = 0;
     std::uint64_t degenerate_facets_removed = 0;  ///< repeated vertex or zero area
+    /// Zero-area facets stitched into the surface, removed by splitting the facet beyond their
+    /// long edge (so no hole opens); counted in degenerate_facets_removed too.
+    std::uint64_t caps_split = 0;
     std::uint64_t duplicate_facets_removed = 0;   ///< same three vertices as an earlier facet
     std::uint64_t flipped_facets = 0;             ///< minority side within each component
     std::uint64_t components_turned_outward = 0;  ///< closed components that were inside out

@@ -93,7 +93,7 @@ Result<ReverseReport> reverse_planar(const Mesh& mesh, const MeshStats& stats,
     brep_detail::silence_occt();
     brep_detail::PlanarTopology topo;
     stage("brep", [&] {
-        topo = brep_detail::planar_topology(mesh, options.method == ReverseMethod::kPlanar,
+        topo = brep_detail::planar_topology(mesh, options.method != ReverseMethod::kFacets,
                                             rep.planar_tolerance);
     });
     rep.faces = topo.faces.size();
@@ -258,13 +258,35 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                                " facets) built from its facets: " + fb.reason);
     }
     rep.segmentation = std::move(*seg);
+    if (!rep.valid && options.method == ReverseMethod::kAuto) {
+        // The last resort, so that a closed mesh always gives a valid closed solid: the whole
+        // part as planar faces (that construction cannot fail), reported as one fallback.
+        const std::string why = "the B-rep from the surfaces is invalid (" +
+                                (brep.problem.empty() ? std::string("unknown") : brep.problem) +
+                                "): the whole part is built with the planar method";
+        ReverseReport planar = rep;
+        planar.faces_by_kind.clear();
+        planar.deviation.reset();
+        planar.volume_difference = 0;
+        planar.warnings.push_back(why);
+        ReverseFallback all;
+        all.region = -1;
+        all.facets = mesh.num_faces();
+        all.kind = "all";
+        all.reason = why;
+        planar.fallbacks.push_back(all);
+        auto out = reverse_planar(mesh, stats, output, options, std::move(planar));
+        if (out && out->solid && out->mesh_volume != 0) {
+            out->volume_difference = (out->solid_volume - out->mesh_volume) / out->mesh_volume;
+        }
+        return out;
+    }
     if (!rep.valid) {
         rep.warnings.push_back("the B-rep is invalid (" +
                                (brep.problem.empty() ? std::string("unknown") : brep.problem) +
                                "): nothing written");
         return rep;
     }
-    (void)stats;
     Status written = Ok{};
     stage("step", [&] {
         brep_detail::StepWriteOptions w;

@@ -76,7 +76,16 @@ Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& p
     try {
         STEPControl_Controller::Init();
         Interface_Static::SetCVal("write.step.schema", schema_name(options.schema));
-        Interface_Static::SetCVal("write.step.unit", options.unit == Unit::kInch ? "INCH" : "MM");
+        // The shape's coordinates are in the file's unit: tell OpenCASCADE so, or it takes
+        // them as millimetres and scales them into the declared unit.
+        const char* unit = options.unit == Unit::kInch ? "INCH" : "MM";
+        Interface_Static::SetCVal("write.step.unit", unit);
+        // Process-wide, and read by STEP readers too: restored when done.
+        struct RestoreCascadeUnit {
+            std::string old = Interface_Static::CVal("xstep.cascade.unit");
+            ~RestoreCascadeUnit() { Interface_Static::SetCVal("xstep.cascade.unit", old.c_str()); }
+        } restore;
+        Interface_Static::SetCVal("xstep.cascade.unit", unit);
         // Header name and time stamp, and the product named as given (OCCT names it "<name>
         // <process-wide counter>").
         const auto name_model = [&](const Handle(StepData_StepModel) & model) {
@@ -108,6 +117,7 @@ Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& p
             // Colors need the XDE document: the shape, each colored face a sub-shape label.
             Handle(TDocStd_Document) doc;
             XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+            XCAFDoc_DocumentTool::SetLengthUnit(doc, options.unit == Unit::kInch ? 0.0254 : 0.001);
             const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
             const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
             const TDF_Label root = shapes->AddShape(shape, false);

@@ -14,6 +14,7 @@
 #include <bit>
 #include <cstring>
 #include <numeric>
+#include <unordered_map>
 
 #include "detail/exact_weld.h"
 #include "ncrev/mesh.h"
@@ -457,6 +458,69 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     report_progress("pair", 0.0);
     std::vector<std::uint32_t> kept(num_in);  // input facet index of each kept facet
     std::iota(kept.begin(), kept.end(), 0u);
+    // Facets added by splitting (index >= num_in in `tri`) and the input facet each came from.
+    std::vector<std::uint32_t> split_origin;
+    const auto source_of = [&](std::uint32_t f) {
+        return f < num_in ? f : split_origin[f - num_in];
+    };
+    // A cap — three distinct vertices in a line, one (c) between the other two (a, b) — that
+    // is stitched into the surface (facets beyond each of its three edges) would leave a hole
+    // if dropped: the facet beyond its long edge (b, a, d) is split at c into (b, c, d) and
+    // (c, a, d), which then meet the cap's other two neighbours, and the cap goes. CAD
+    // tessellations make such caps where a face's boundary has a vertex in the middle of the
+    // neighbouring face's edge.
+    const auto split_caps = [&](std::vector<std::uint8_t>& bad) {
+        std::vector<std::size_t> caps;
+        for (std::size_t k = 0; k < kept.size(); ++k) {
+            const auto& t = tri[kept[k]];
+            if (bad[k] && t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) caps.push_back(k);
+        }
+        if (caps.empty()) return;
+        const auto key = [](std::uint32_t a, std::uint32_t b) {
+            return (std::uint64_t{a} << 32) | b;
+        };
+        std::unordered_map<std::uint64_t, std::size_t> owner;  // directed edge -> kept slot
+        for (std::size_t k = 0; k < kept.size(); ++k) {
+            if (bad[k]) continue;
+            const auto& t = tri[kept[k]];
+            for (int i = 0; i < 3; ++i) owner[key(t[i], t[(i + 1) % 3])] = k;
+        }
+        for (std::size_t k : caps) {
+            const auto t = tri[kept[k]];
+            // The long edge a -> b (its vertex c between them).
+            int best = 0;
+            double longest = -1;
+            for (int i = 0; i < 3; ++i) {
+                const Vec3 d = vpos[t[(i + 1) % 3]] - vpos[t[i]];
+                if (dot(d, d) > longest) longest = dot(d, d), best = i;
+            }
+            const std::uint32_t a = t[best], b = t[(best + 1) % 3], c = t[(best + 2) % 3];
+            const auto across = owner.find(key(b, a));
+            if (across == owner.end() || !owner.count(key(c, b)) || !owner.count(key(a, c))) {
+                continue;  // not stitched in: dropping it leaves no hole
+            }
+            const std::size_t n = across->second;
+            auto& u = tri[kept[n]];
+            int at = 0;
+            while (u[at] != b) ++at;
+            const std::uint32_t d = u[(at + 2) % 3];
+            if (u[(at + 1) % 3] != a || d == c) continue;
+            u = {b, c, d};
+            tri.push_back({c, a, d});
+            split_origin.push_back(source_of(kept[n]));
+            kept.push_back(static_cast<std::uint32_t>(tri.size() - 1));
+            bad.push_back(0);
+            const std::size_t nk = kept.size() - 1;
+            owner.erase(key(b, a));
+            owner[key(b, c)] = n;
+            owner[key(c, d)] = n;
+            owner[key(d, b)] = n;
+            owner[key(c, a)] = nk;
+            owner[key(a, d)] = nk;
+            owner[key(d, c)] = nk;
+            ++rep.caps_split;
+        }
+    };
     auto drop_degenerate = [&]() {
         std::vector<std::uint8_t> bad(kept.size(), 0);
         for_chunks(kept.size(), [&](std::size_t b, std::size_t e) {
@@ -474,6 +538,7 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
                 if (area2 <= tol * longest) bad[k] = 1;
             }
         });
+        split_caps(bad);
         std::size_t w = 0;
         for (std::size_t k = 0; k < kept.size(); ++k) {
             if (bad[k]) {
@@ -746,6 +811,7 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     mesh.position_ = std::move(vpos);
 
     // 9. Per-face columns carried from the input.
+    for (std::uint32_t& f : kept) f = source_of(f);
     mesh.source_face_ = std::move(kept);
     if (attrs) {
         mesh.color_.resize(nf);

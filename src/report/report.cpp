@@ -115,6 +115,7 @@ nlohmann::json info_json(const InfoReport& r) {
                     {"welded_vertices", h.welded_vertices},
                     {"unreferenced_vertices", h.unreferenced_vertices},
                     {"degenerate_facets_removed", h.degenerate_facets_removed},
+                    {"caps_split", h.caps_split},
                     {"duplicate_facets_removed", h.duplicate_facets_removed},
                     {"flipped_facets", h.flipped_facets},
                     {"components_turned_outward", h.components_turned_outward},
