@@ -7,6 +7,8 @@
 #include <TopExp.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 
 #include "brep/deviation.h"
 #include "brep/planar.h"
@@ -184,10 +186,50 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     }
     const SegmentResult& sr = *seg;
     rep.chordal_deflection = sr.chordal_deflection;
+    // Free-form regions were held to the chordal deflection while segmenting (their pieces
+    // had to merge); the mesh's vertices lie on the surface itself, so the face's B-spline is
+    // fitted again to them, to the segmentation tolerance where a net reaches it.
+    std::vector<FitResult> refits(sr.regions.size());
+    stage("refit", [&] {
+        std::vector<std::vector<Vec3>> points(sr.regions.size());
+        std::vector<std::vector<std::uint8_t>> seen(sr.regions.size());
+        for (std::size_t r = 0; r < sr.regions.size(); ++r) {
+            if (sr.regions[r].fit.ok && sr.regions[r].fit.surface.kind == FitKind::kBSpline) {
+                seen[r].assign(mesh.num_vertices(), 0);
+            }
+        }
+        for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
+            const auto r = static_cast<std::size_t>(sr.region[FaceId(f)]);
+            if (seen[r].empty()) continue;
+            for (int i = 0; i < 3; ++i) {
+                const VertexId v = mesh.vertex(FaceId(f), i);
+                if (seen[r][v.idx()]) continue;
+                seen[r][v.idx()] = 1;
+                points[r].push_back(mesh.position(v));
+            }
+        }
+        for (std::size_t r = 0; r < sr.regions.size(); ++r) {
+            if (points[r].empty()) continue;
+            FitInput in;
+            in.points = points[r];
+            if (std::getenv("NCREV_DEBUG")) {
+                std::fprintf(stderr, "region %zu bspline max %g, %zu points\n", r,
+                             sr.regions[r].fit.max, points[r].size());
+            }
+            // The tightest of tolerance x 1, 4, 16 ... that a net reaches.
+            for (double tol = sr.tolerance; tol < sr.regions[r].fit.max; tol *= 4) {
+                FitResult f = fit_bspline(in, tol);
+                if (f.ok && f.max < sr.regions[r].fit.max) {
+                    refits[r] = std::move(f);
+                    break;
+                }
+            }
+        }
+    });
     std::vector<brep_detail::RegionSurface> surfaces(sr.regions.size());
     for (std::size_t r = 0; r < sr.regions.size(); ++r) {
         const Region& g = sr.regions[r];
-        surfaces[r].surface = g.fit.surface;
+        surfaces[r].surface = refits[r].ok ? refits[r].surface : g.fit.surface;
         surfaces[r].has_surface = g.fit.ok && g.within_tolerance;
         if (!g.fit.ok) {
             surfaces[r].no_surface_reason = "no surface fits the region";
@@ -207,6 +249,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     rep.max_corner_residual = brep.max_corner_residual;
     rep.max_tolerance = brep.max_tolerance;
     rep.edges_by_curve = {{"intersection", brep.intersection_edges},
+                          {"analytic", brep.analytic_edges},
                           {"fitted", brep.fitted_edges},
                           {"polyline", brep.polyline_edges}};
     for (std::size_t r = 0; r < brep.regions.size(); ++r) {

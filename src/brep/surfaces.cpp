@@ -31,15 +31,21 @@
 #include <GeomAPI_Interpolate.hxx>
 #include <GeomAPI_ProjectPointOnCurve.hxx>
 #include <GeomAPI_ProjectPointOnSurf.hxx>
+#include <GeomAdaptor_Surface.hxx>
+#include <Geom_BSplineCurve.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Geom_Circle.hxx>
 #include <Geom_ConicalSurface.hxx>
 #include <Geom_CylindricalSurface.hxx>
+#include <Geom_Ellipse.hxx>
+#include <Geom_Line.hxx>
 #include <Geom_OffsetSurface.hxx>
 #include <Geom_Plane.hxx>
 #include <Geom_SphericalSurface.hxx>
 #include <Geom_SurfaceOfLinearExtrusion.hxx>
 #include <Geom_ToroidalSurface.hxx>
+#include <Geom_TrimmedCurve.hxx>
+#include <IntAna_QuadQuadGeo.hxx>
 #include <Precision.hxx>
 #include <ShapeBuild_ReShape.hxx>
 #include <ShapeFix_Edge.hxx>
@@ -47,6 +53,7 @@
 #include <Standard_Failure.hxx>
 #include <TColStd_Array1OfInteger.hxx>
 #include <TColStd_Array1OfReal.hxx>
+#include <TColgp_Array1OfPnt.hxx>
 #include <TColgp_Array2OfPnt.hxx>
 #include <TColgp_HArray1OfPnt.hxx>
 #include <TopExp.hxx>
@@ -61,6 +68,8 @@
 #include <TopoDS_Wire.hxx>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <sstream>
 #include <unordered_map>
@@ -219,8 +228,23 @@ struct ChainCurve {
 // project. The curve is reversed when the chain runs against it.
 bool trim_along(Handle(Geom_Curve) c, const std::vector<gp_Pnt>& points, bool closed,
                 ChainCurve& out) {
-    const bool periodic = c->IsPeriodic() || c->IsClosed();
-    const double period = c->IsPeriodic() ? c->Period() : c->LastParameter() - c->FirstParameter();
+    // A trimmed curve (the general intersection's circles come so) is its basis curve.
+    for (Handle(Geom_TrimmedCurve) t = Handle(Geom_TrimmedCurve)::DownCast(c); !t.IsNull();
+         t = Handle(Geom_TrimmedCurve)::DownCast(c)) {
+        c = t->BasisCurve();
+    }
+    // A closed B-spline (what the intersection gives for a loop such as a cone meeting a
+    // cylinder) made periodic, so that a chain may run across its start.
+    if (!c->IsPeriodic() && c->IsClosed()) {
+        const Handle(Geom_BSplineCurve) bs = Handle(Geom_BSplineCurve)::DownCast(c);
+        if (bs.IsNull()) return false;
+        const Handle(Geom_BSplineCurve) copy = Handle(Geom_BSplineCurve)::DownCast(bs->Copy());
+        copy->SetPeriodic();
+        if (!copy->IsPeriodic()) return false;
+        c = copy;
+    }
+    const bool periodic = c->IsPeriodic();
+    const double period = periodic ? c->Period() : 0;
     std::vector<double> u;
     u.reserve(points.size());
     double dev = 0;
@@ -271,34 +295,162 @@ std::vector<gp_Pnt> chain_samples(const std::vector<gp_Pnt>& points) {
     return out;
 }
 
-// The intersection branch of `a` and `b` along `points`, within `accept` of all of them.
-bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surface) & b,
-                        const std::vector<gp_Pnt>& points, bool closed, double accept,
-                        ChainCurve& out) {
-    GeomAPI_IntSS inter(a, b, Precision::Confusion());
-    if (!inter.IsDone()) return false;
-    const std::vector<gp_Pnt> samples = chain_samples(points);
-    bool found = false;
-    for (int i = 1; i <= inter.NbLines(); ++i) {
-        ChainCurve c;
-        if (!trim_along(inter.Line(i), samples, closed, c)) continue;
-        if (c.deviation > accept) continue;
-        if (!found || c.deviation < out.deviation) {
-            out = c;
-            found = true;
+// The exact intersection of two elementary surfaces (planes, cylinders, cones, spheres, tori)
+// as lines, circles and ellipses (IntAna_QuadQuadGeo); empty when the pair is not elementary
+// or the answer is another kind of curve.
+std::vector<Handle(Geom_Curve)> analytic_intersection(const Handle(Geom_Surface) & a,
+                                                      const Handle(Geom_Surface) & b) {
+    GeomAdaptor_Surface sa(a), sb(b);
+    // Order: plane, cylinder, sphere, cone, torus (the order IntAna's constructors take).
+    const auto rank = [](GeomAbs_SurfaceType t) {
+        switch (t) {
+            case GeomAbs_Plane:
+                return 0;
+            case GeomAbs_Cylinder:
+                return 1;
+            case GeomAbs_Sphere:
+                return 2;
+            case GeomAbs_Cone:
+                return 3;
+            case GeomAbs_Torus:
+                return 4;
+            default:
+                return -1;
+        }
+    };
+    int ra = rank(sa.GetType()), rb = rank(sb.GetType());
+    if (ra < 0 || rb < 0) return {};
+    const GeomAdaptor_Surface& lo = ra <= rb ? sa : sb;
+    const GeomAdaptor_Surface& hi = ra <= rb ? sb : sa;
+    if (ra > rb) std::swap(ra, rb);
+    const double tol = Precision::Confusion(), ang = Precision::Angular();
+    IntAna_QuadQuadGeo q;
+    switch (ra * 5 + rb) {
+        case 0:
+            q = IntAna_QuadQuadGeo(lo.Plane(), hi.Plane(), ang, tol);
+            break;
+        case 1:
+            q = IntAna_QuadQuadGeo(lo.Plane(), hi.Cylinder(), ang, tol);
+            break;
+        case 2:
+            q = IntAna_QuadQuadGeo(lo.Plane(), hi.Sphere());
+            break;
+        case 3:
+            q = IntAna_QuadQuadGeo(lo.Plane(), hi.Cone(), ang, tol);
+            break;
+        case 4:
+            q = IntAna_QuadQuadGeo(lo.Plane(), hi.Torus(), tol);
+            break;
+        case 6:
+            q = IntAna_QuadQuadGeo(lo.Cylinder(), hi.Cylinder(), tol);
+            break;
+        case 7:
+            q = IntAna_QuadQuadGeo(lo.Cylinder(), hi.Sphere(), tol);
+            break;
+        case 8:
+            q = IntAna_QuadQuadGeo(lo.Cylinder(), hi.Cone(), tol);
+            break;
+        case 9:
+            q = IntAna_QuadQuadGeo(lo.Cylinder(), hi.Torus(), tol);
+            break;
+        case 12:
+            q = IntAna_QuadQuadGeo(lo.Sphere(), hi.Sphere(), tol);
+            break;
+        case 13:
+            q = IntAna_QuadQuadGeo(lo.Sphere(), hi.Cone(), tol);
+            break;
+        case 14:
+            q = IntAna_QuadQuadGeo(lo.Sphere(), hi.Torus(), tol);
+            break;
+        case 18:
+            q = IntAna_QuadQuadGeo(lo.Cone(), hi.Cone(), tol);
+            break;
+        case 19:
+            q = IntAna_QuadQuadGeo(lo.Cone(), hi.Torus(), tol);
+            break;
+        case 24:
+            q = IntAna_QuadQuadGeo(lo.Torus(), hi.Torus(), tol);
+            break;
+        default:
+            return {};
+    }
+    std::vector<Handle(Geom_Curve)> out;
+    if (!q.IsDone()) return out;
+    for (int i = 1; i <= q.NbSolutions(); ++i) {
+        switch (q.TypeInter()) {
+            case IntAna_Line:
+                out.push_back(new Geom_Line(q.Line(i)));
+                break;
+            case IntAna_Circle:
+                out.push_back(new Geom_Circle(q.Circle(i)));
+                break;
+            case IntAna_Ellipse:
+                out.push_back(new Geom_Ellipse(q.Ellipse(i)));
+                break;
+            default:
+                return {};
         }
     }
-    return found;
+    return out;
 }
 
-// A curve through `points` (already on both surfaces), periodic when the chain is closed.
-bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, ChainCurve& out) {
+// The intersection branch of `a` and `b` along `points`, within `accept` of all of them:
+// analytic for elementary pairs, else OpenCASCADE's general surface intersection.
+bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surface) & b,
+                        const std::vector<gp_Pnt>& points, bool closed, double accept,
+                        ChainCurve& out, bool& analytic) {
+    const std::vector<gp_Pnt> samples = chain_samples(points);
+    const auto best_of = [&](const std::vector<Handle(Geom_Curve)>& lines) {
+        bool found = false;
+        for (const Handle(Geom_Curve) & line : lines) {
+            ChainCurve c;
+            if (!trim_along(line, samples, closed, c) || c.deviation > accept) continue;
+            if (!found || c.deviation < out.deviation) {
+                out = c;
+                found = true;
+            }
+        }
+        return found;
+    };
+    analytic = true;
+    if (best_of(analytic_intersection(a, b))) return true;
+    analytic = false;
+    GeomAPI_IntSS inter(a, b, Precision::Confusion());
+    if (!inter.IsDone()) return false;
+    std::vector<Handle(Geom_Curve)> lines;
+    for (int i = 1; i <= inter.NbLines(); ++i) lines.push_back(inter.Line(i));
+    return best_of(lines);
+}
+
+// A curve through `points` (already on both surfaces): a cubic interpolation, periodic when
+// the chain is closed, or (`linear`) the degree-1 B-spline through them, chord-length knots.
+bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, ChainCurve& out) {
     std::vector<gp_Pnt> p;
     for (const gp_Pnt& q : points) {
         if (p.empty() || p.back().Distance(q) > 10 * kMinTolerance) p.push_back(q);
     }
     if (closed && p.size() > 1 && p.back().Distance(p.front()) <= 10 * kMinTolerance) p.pop_back();
     if (p.size() < (closed ? 3u : 2u)) return false;
+    if (linear) {
+        if (closed) p.push_back(p.front());
+        const int n = static_cast<int>(p.size());
+        TColgp_Array1OfPnt poles(1, n);
+        TColStd_Array1OfReal knots(1, n);
+        TColStd_Array1OfInteger mults(1, n);
+        double len = 0;
+        for (int i = 0; i < n; ++i) {
+            const auto k = static_cast<std::size_t>(i);
+            if (i > 0) len += p[k].Distance(p[k - 1]);
+            poles.SetValue(i + 1, p[k]);
+            knots.SetValue(i + 1, len);
+            mults.SetValue(i + 1, (i == 0 || i == n - 1) ? 2 : 1);
+        }
+        out.curve = new Geom_BSplineCurve(poles, knots, mults, 1);
+        out.first = 0;
+        out.last = len;
+        out.deviation = 0;
+        return true;
+    }
     Handle(TColgp_HArray1OfPnt) arr = new TColgp_HArray1OfPnt(1, static_cast<int>(p.size()));
     for (std::size_t i = 0; i < p.size(); ++i) arr->SetValue(static_cast<int>(i) + 1, p[i]);
     GeomAPI_Interpolate interp(arr, closed, kMinTolerance);
@@ -309,6 +461,36 @@ bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, ChainCurve& ou
     out.last = out.curve->LastParameter();
     out.deviation = 0;
     return true;
+}
+
+// The chain's points with points solved onto both surfaces inserted between them wherever
+// the straight segment strays from the surfaces by more than a quarter of `tolerance`: a coarse
+// mesh has few vertices along a curved junction (a free-form face meeting a plane).
+void densify(const gp_Pnt& p, const gp_Pnt& q, std::span<const Surface> pair, double tolerance,
+             int depth, std::vector<gp_Pnt>& out) {
+    const Vec3 mid = 0.5 * (vec(p) + vec(q));
+    const CommonPoint m = common_point(pair, mid);
+    // A sagitta beyond a quarter of the chord means the solve left the junction (tangent
+    // surfaces give it no grip along their common line): the chord stays.
+    const double moved = norm(m.point - mid);
+    if (depth > 0 && moved > 0.25 * tolerance && moved < 0.25 * p.Distance(q) &&
+        m.residual <= tolerance) {
+        densify(p, pnt(m.point), pair, tolerance, depth - 1, out);
+        out.push_back(pnt(m.point));
+        densify(pnt(m.point), q, pair, tolerance, depth - 1, out);
+    }
+}
+
+std::vector<gp_Pnt> densified(const std::vector<gp_Pnt>& pts, std::span<const Surface> pair,
+                              double tolerance) {
+    // Up to 2^5 - 1 points between two chain vertices.
+    constexpr int kDepth = 5;
+    std::vector<gp_Pnt> out;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        if (i > 0) densify(pts[i - 1], pts[i], pair, tolerance, kDepth, out);
+        out.push_back(pts[i]);
+    }
+    return out;
 }
 
 // The largest distance from the curve to the surfaces, at the midpoints of its spans between
@@ -527,6 +709,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     for (int round = 1; round <= kMaxRounds; ++round) {
         out.rounds = round;
         out.intersection_edges = out.fitted_edges = out.polyline_edges = 0;
+        out.analytic_edges = 0;
         out.corners = 0;
         out.max_corner_residual = 0;
         // 2. Vertices: solved corners (and loop starts); other mesh vertices at their place.
@@ -621,15 +804,40 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 bool ok = false, intersected = false;
                 try {
                     if (min_sin > std::sin(kTangentAngle)) {
+                        bool analytic = false;
                         ok = intersection_curve(geom[ra], geom[rb], pts, ch.closed,
-                                                opt.chordal_deflection + opt.tolerance, cc);
+                                                opt.chordal_deflection + opt.tolerance, cc,
+                                                analytic);
                         intersected = ok;
+                        if (ok && analytic) ++out.analytic_edges;
                     }
-                    if (!ok && fitted_curve(pts, ch.closed, cc)) {
-                        // Its tolerance: how far it strays from the two surfaces.
-                        cc.deviation =
-                            curve_off_surfaces(cc, sa, sb, static_cast<int>(ch.vertices.size()));
-                        ok = cc.deviation <= max_tol;
+                    if (!ok) {
+                        // A cubic through the points; where it swings off the surfaces (points
+                        // unevenly spaced, a kink where the chain leaves the junction), the
+                        // piecewise-linear curve through them. Its tolerance: how far it
+                        // strays from the two surfaces.
+                        // The closest to the surfaces of: the cubic through the chain's
+                        // points, the cubic through them densified, the linear one.
+                        // Densified only where the surfaces cross: along a tangent junction every
+                        // point of a band about the tangency line is on both to the tolerance,
+                        // and solved points would wander across it.
+                        const std::vector<gp_Pnt> dense = min_sin > std::sin(kTangentAngle)
+                                                              ? densified(pts, pair, opt.tolerance)
+                                                              : pts;
+                        const int samples = 4 * static_cast<int>(dense.size());
+                        ChainCurve best;
+                        best.deviation = -1;
+                        for (int variant = 0; variant < 3; ++variant) {
+                            ChainCurve t;
+                            if (!fitted_curve(variant == 0 ? pts : dense, ch.closed, variant == 2,
+                                              t)) {
+                                continue;
+                            }
+                            t.deviation = curve_off_surfaces(t, sa, sb, samples);
+                            if (best.deviation < 0 || t.deviation < best.deviation) best = t;
+                        }
+                        ok = best.deviation >= 0 && best.deviation <= max_tol;
+                        if (ok) cc = best;
                     }
                     if (ok) {
                         // The vertices reach the curve's ends.
@@ -640,9 +848,20 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                                                     1.01 * e1.Distance(BRep_Tool::Pnt(V1))));
                         BRepBuilderAPI_MakeEdge me(cc.curve, V0, V1, cc.first, cc.last);
                         ok = me.IsDone();
+                        if (!ok && std::getenv("NCREV_DEBUG")) {
+                            std::fprintf(stderr, "make edge %d: %s %g %g periodic %d\n",
+                                         static_cast<int>(me.Error()),
+                                         cc.curve->DynamicType()->Name(), cc.first, cc.last,
+                                         static_cast<int>(cc.curve->IsPeriodic()));
+                        }
                         if (ok) {
                             TopoDS_Edge e = me.Edge();
                             B.UpdateEdge(e, std::max(kMinTolerance, 1.01 * cc.deviation));
+                            if (std::getenv("NCREV_DEBUG")) {
+                                std::fprintf(stderr, "chain %zu (%d|%d) %s dev %g n %zu sin %g\n",
+                                             c, ch.left, ch.right, intersected ? "int" : "fit",
+                                             cc.deviation, ch.vertices.size(), min_sin);
+                            }
                             chain_edges[c].push_back(e);
                             ++(intersected ? out.intersection_edges : out.fitted_edges);
                         }
@@ -651,6 +870,11 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     ok = false;
                 }
                 if (ok) continue;
+                if (std::getenv("NCREV_DEBUG")) {
+                    std::fprintf(stderr, "chain %zu (%d|%d) closed %d n %zu min_sin %g dev %g\n", c,
+                                 ch.left, ch.right, ch.closed, ch.vertices.size(), min_sin,
+                                 cc.deviation);
+                }
                 failed_chain.push_back(static_cast<std::int32_t>(c));
             }
             // The chain's own segments.

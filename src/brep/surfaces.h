@@ -49,6 +49,9 @@ struct SurfaceBrep {
     /// analytic for elementary pairs), "fitted" (a curve through the chain's points solved onto
     /// both surfaces: tangent junctions, failed intersections), "polyline" (beside a fallback).
     std::uint64_t intersection_edges = 0, fitted_edges = 0, polyline_edges = 0;
+    /// Of the intersection edges, those whose curve is exact (IntAna: a line, circle or
+    /// ellipse where two elementary surfaces meet).
+    std::uint64_t analytic_edges = 0;
     std::uint64_t corners = 0;
     double max_corner_residual = 0;  ///< largest distance of a solved corner from its surfaces
     double max_tolerance = 0;        ///< largest vertex / edge / face tolerance of the result
