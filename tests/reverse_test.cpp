@@ -359,8 +359,23 @@ TEST(ReverseStudy, DISABLED_Corpus) {
                         made.error().describe().c_str());
             continue;
         }
+        if (const char* dump = std::getenv("DUMP")) {  // DUMP=dir: the mesh as NAME.stl there
+            const SamplePart& p = made.value();
+            const auto bytes = encode_stl_binary(p.mesh.points, p.mesh.triangles);
+            std::ofstream(std::filesystem::path(dump) / (path.stem().string() + ".stl"),
+                          std::ios::binary)
+                .write(reinterpret_cast<const char*>(bytes.data()),
+                       static_cast<std::streamsize>(bytes.size()));
+        }
         const Outcome o = reverse_part(made.value(), false, ReverseMethod::kAuto, "study");
         print_row(path.filename().string(), "STL", o);
+        if (only) {
+            for (const ReverseFallback& f : o.report.fallbacks) {
+                std::printf("|   fallback: region %d (%s, %llu facets): %s |\n", f.region,
+                            f.kind.c_str(), static_cast<unsigned long long>(f.facets),
+                            f.reason.c_str());
+            }
+        }
         if (!o.mesh.closed) {
             std::printf(
                 "|   open mesh: %llu boundary edges in %llu loops, %llu components; healing: %llu "

@@ -50,6 +50,7 @@
 #include <ShapeBuild_ReShape.hxx>
 #include <ShapeFix_Edge.hxx>
 #include <ShapeFix_Face.hxx>
+#include <ShapeFix_Wire.hxx>
 #include <Standard_Failure.hxx>
 #include <TColStd_Array1OfInteger.hxx>
 #include <TColStd_Array1OfReal.hxx>
@@ -68,6 +69,7 @@
 #include <TopoDS_Wire.hxx>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
@@ -90,9 +92,9 @@ constexpr double kTangentAngle = 0.17453292519943295;
 constexpr std::size_t kChainSamples = 24;
 // Facet centroids used to find which way a surface's natural normal points.
 constexpr std::size_t kOrientationSamples = 16;
-// Build rounds: each round turns the regions whose faces failed into facets; a failure
-// spreads at most to neighbours, so a few rounds settle.
-constexpr int kMaxRounds = 6;
+// Build rounds: each round turns (the smallest of) the regions whose faces failed into facets;
+// a failure spreads at most to neighbours, so a few rounds settle.
+constexpr int kMaxRounds = 12;
 
 gp_Pnt pnt(Vec3 v) { return {v.x, v.y, v.z}; }
 Vec3 vec(const gp_Pnt& p) { return {p.X(), p.Y(), p.Z()}; }
@@ -556,6 +558,7 @@ struct Builder {
     const SurfaceBrepOptions& opt;
     RegionBorders borders;
     std::vector<RegionShape> shapes;
+    std::vector<std::size_t> facets;  ///< per region
     // Per half-edge: the chain it lies on (-1 inside a region), and whether it runs along it.
     std::vector<std::int32_t> he_chain;
     std::vector<std::uint8_t> he_forward;
@@ -583,6 +586,8 @@ struct Builder {
             shapes[r].area += a;
             faces[r].push_back(id);
         }
+        facets.resize(nr);
+        for (std::size_t r = 0; r < nr; ++r) facets[r] = faces[r].size();
         for (std::size_t r = 0; r < nr; ++r) {
             RegionShape& s = shapes[r];
             if (s.area > 0) s.centroid = (1.0 / s.area) * s.centroid;
@@ -766,6 +771,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             const TopoDS_Vertex va = plain_vertex(VertexId(lo)), vb = plain_vertex(VertexId(hi));
             BRepBuilderAPI_MakeEdge me(va, vb);
             TopoDS_Edge e = me.IsDone() ? me.Edge() : TopoDS_Edge();
+            if (e.IsNull() && std::getenv("NCREV_DEBUG")) {
+                std::fprintf(stderr, "null segment %u %u\n", lo, hi);
+            }
             segment.emplace(key, e);
             return e;
         };
@@ -946,6 +954,22 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     fix.SetPrecision(kMinTolerance);
                     fix.SetMinTolerance(kMinTolerance);
                     fix.SetMaxTolerance(max_tol);
+                    // Only the fixes that keep the edges shared with the neighbours: curves on
+                    // the surface, seams, poles, orientation. Those that drop, merge, split or
+                    // add edges or wires (small edges and wires, self-intersections, lacking
+                    // edges, loops) would leave a neighbour's edge without its twin.
+                    fix.FixSmallAreaWireMode() = 0;
+                    fix.FixIntersectingWiresMode() = 0;
+                    fix.FixLoopWiresMode() = 0;
+                    fix.FixSplitFaceMode() = 0;
+                    const Handle(ShapeFix_Wire)& wire_fix = fix.FixWireTool();
+                    wire_fix->FixReorderMode() = 0;
+                    wire_fix->FixSmallMode() = 0;
+                    wire_fix->FixConnectedMode() = 0;
+                    wire_fix->FixSelfIntersectionMode() = 0;
+                    wire_fix->FixLackingMode() = 0;
+                    wire_fix->FixNotchedEdgesMode() = 0;
+                    wire_fix->FixTailMode() = 0;
                     fix.Perform();
                     F = fix.Face();
                     // Edges the fix added or changed (seams, split edges) get their parameter
@@ -956,6 +980,25 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 }
                 if (sense[r] < 0) F.Reverse();
                 if (std::string why = check_failure(F); !why.empty()) {
+                    if (std::getenv("NCREV_DEBUG")) {
+                        const Surface& su = regions[r].surface;
+                        std::fprintf(stderr,
+                                     "region %zu %s p %g %g %g a %g %g %g r %g sense %d loops "
+                                     "%zu: %s\n",
+                                     r, to_string(su.kind), su.point.x, su.point.y, su.point.z,
+                                     su.axis.x, su.axis.y, su.axis.z, su.radius, sense[r],
+                                     bd.loops[r].size(), why.c_str());
+                        for (const auto& loop : bd.loops[r]) {
+                            std::fprintf(stderr, "  loop:");
+                            for (const auto& [c, fwd] : loop) {
+                                const BorderChain& ch = borders.chains[static_cast<std::size_t>(c)];
+                                std::fprintf(stderr, " %d%s(%d|%d n%zu%s)", c, fwd ? "+" : "-",
+                                             ch.left, ch.right, ch.vertices.size(),
+                                             ch.closed ? " closed" : "");
+                            }
+                            std::fprintf(stderr, "\n");
+                        }
+                    }
                     failed_region.emplace_back(r,
                                                "its face fails OpenCASCADE's check (" + why + ")");
                     continue;
@@ -987,7 +1030,10 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             const gp_Pnt p1 = BRep_Tool::Pnt(plain_vertex(m.vertex(f, 1)));
             const gp_Pnt p2 = BRep_Tool::Pnt(plain_vertex(m.vertex(f, 2)));
             const gp_Vec n = gp_Vec(p0, p1).Crossed(gp_Vec(p0, p2));
-            if (n.Magnitude() <= 0) continue;
+            if (n.Magnitude() <= 0) {
+                if (std::getenv("NCREV_DEBUG")) std::fprintf(stderr, "zero facet %u\n", fi);
+                continue;
+            }
             TopoDS_Face F;
             B.MakeFace(F, new Geom_Plane(p0, gp_Dir(n)), kMinTolerance);
             B.Add(F, W);
@@ -999,7 +1045,19 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                               failed_region.front().second;
                 return out;
             }
-            for (auto& [r, why] : failed_region) fall_back(r, std::move(why));
+            // Smallest first: a sliver region's failing face often takes a large neighbour's
+            // with it (their shared edges zigzag); once the sliver is facets, the neighbour's
+            // face usually builds. Regions more than 4x larger than the smallest failing one
+            // get another round (all of them in the last).
+            std::size_t smallest = SIZE_MAX;
+            for (const auto& [r, why] : failed_region) {
+                smallest = std::min(smallest, bd.facets[r]);
+            }
+            for (auto& [r, why] : failed_region) {
+                if (round == kMaxRounds || bd.facets[r] <= 4 * smallest) {
+                    fall_back(r, std::move(why));
+                }
+            }
             continue;
         }
 
@@ -1013,6 +1071,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         TopTools_IndexedDataMapOfShapeListOfShape edge_faces;
         TopExp::MapShapesAndUniqueAncestors(fixed, TopAbs_EDGE, TopAbs_FACE, edge_faces);
         bool closed = true;
+        std::vector<TopoDS_Shape> open_faces;  // faces along an edge that has no other face
         for (int i = 1; i <= edge_faces.Extent(); ++i) {
             const TopoDS_Edge& e = TopoDS::Edge(edge_faces.FindKey(i));
             if (BRep_Tool::Degenerated(e)) continue;
@@ -1021,6 +1080,13 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             if (n == 1 && BRep_Tool::IsClosed(e, TopoDS::Face(edge_faces.FindFromIndex(i).First())))
                 continue;
             closed = false;
+            for (const TopoDS_Shape& f : edge_faces.FindFromIndex(i)) open_faces.push_back(f);
+            if (std::getenv("NCREV_DEBUG")) {
+                const TopoDS_Vertex a = TopExp::FirstVertex(e), b = TopExp::LastVertex(e);
+                const gp_Pnt pa = BRep_Tool::Pnt(a), pb = BRep_Tool::Pnt(b);
+                std::fprintf(stderr, "open edge: %d faces, %g %g %g -> %g %g %g\n", n, pa.X(),
+                             pa.Y(), pa.Z(), pb.X(), pb.Y(), pb.Z());
+            }
         }
         for (std::size_t r = 0; r < nr; ++r) {
             out.regions[r].faces.clear();
@@ -1044,11 +1110,11 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         }
         out.shape = result;
         out.solid = closed;
-        std::vector<TopoDS_Shape> bad;
-        const std::string why = check_failure(result, &bad);
+        std::vector<TopoDS_Shape> bad = open_faces;
+        const std::string why =
+            closed ? check_failure(result, &bad) : std::string("the shell is not closed");
         out.valid = why.empty() && closed;
-        if (!why.empty()) out.problem = "BRepCheck_Analyzer: " + why;
-        if (!closed) out.problem = "the shell is not closed";
+        if (!why.empty()) out.problem = closed ? "BRepCheck_Analyzer: " + why : why;
         if (out.valid || !opt.allow_fallback) break;
         // The regions whose faces hold what the check finds wrong become facets.
         TopTools_IndexedMapOfShape bad_faces;

@@ -1277,21 +1277,26 @@ RegionBorders region_borders(const Mesh& m, const FaceMap<std::int32_t>& face_re
     // Each border edge is walked once, from the side of the larger region (the boundary, -1,
     // is always on the right).
     const auto is_border = [&](HalfedgeId h) { return face_region[Mesh::face(h)] > across(h); };
-    // Corners: vertices whose fan meets three or more sides (regions, the boundary as one).
+    // Corners: vertices whose fan meets three or more sides (regions, the boundary as one), or
+    // where more than two border edges meet.
     RegionBorders out;
     std::vector<std::uint8_t> corner(nv, 0);
     std::vector<std::int32_t> sides;
     for (std::uint32_t v = 0; v < nv; ++v) {
         sides.clear();
         bool boundary = false;
+        // Border edges at v: more than two where a region's border touches itself (a pinch:
+        // two regions meeting at v along two separate borders), which must end chains too.
+        int border_edges = 0;
         m.for_each_outgoing(VertexId(v), [&](HalfedgeId h) {
             sides.push_back(face_region[Mesh::face(h)]);
             boundary = boundary || !m.twin(h).is_valid() || !m.twin(Mesh::prev(h)).is_valid();
+            if (face_region[Mesh::face(h)] != across(h)) ++border_edges;
         });
         std::sort(sides.begin(), sides.end());
         const std::size_t distinct =
             static_cast<std::size_t>(std::unique(sides.begin(), sides.end()) - sides.begin());
-        if (distinct + (boundary ? 1 : 0) >= 3) {
+        if (distinct + (boundary ? 1 : 0) >= 3 || border_edges > 2) {
             corner[v] = 1;
             out.corners.push_back(VertexId(v));
         }
