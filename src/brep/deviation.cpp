@@ -175,7 +175,8 @@ DistanceStats stats_of(const std::vector<Vec3>& points, const TriangleGrid& grid
 SolidDeviation measure_deviation(const TopoDS_Shape& shape, const Mesh& mesh, double deflection) {
     SolidDeviation out;
     out.deflection = deflection;
-    BRepMesh_IncrementalMesh(shape, deflection, false, 0.2, false);
+    // In parallel over faces (each face's triangulation does not depend on the others').
+    BRepMesh_IncrementalMesh(shape, deflection, false, 0.2, true);
     std::vector<Triangle> solid_tris;
     std::vector<Vec3> solid_nodes;
     for (TopExp_Explorer x(shape, TopAbs_FACE); x.More(); x.Next()) {

@@ -291,7 +291,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             }
             if (options.measure_deviation && rep.valid) {
                 rep.deviation = brep_detail::measure_deviation(
-                    brep.shape, mesh, 0.25 * std::max(sr.chordal_deflection, sr.tolerance));
+                    brep.shape, mesh, 0.5 * std::max(sr.chordal_deflection, sr.tolerance));
             }
         });
     }
@@ -337,6 +337,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         w.unit = options.unit;
         w.product_name = options.product_name.empty() ? "ncrev" : options.product_name;
         if (options.colors) {
+            w.shape_color = kind_color("facet");
             const std::vector<std::int64_t> tool = region_colors(mesh, *rep.segmentation);
             for (std::size_t r = 0; r < brep.regions.size(); ++r) {
                 const brep_detail::RegionBuild& b = brep.regions[r];
@@ -345,6 +346,9 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                     : b.fallback
                         ? kind_color("facet")
                         : kind_color(to_string(rep.segmentation->regions[r].fit.surface.kind));
+                // Fallback facets take the shape's color (below): thousands of colored
+                // sub-shapes would cost more than the rest of the STEP.
+                if (b.fallback && tool[r] < 0) continue;
                 for (const TopoDS_Face& f : b.faces) w.face_colors.emplace_back(f, rgb);
             }
         }

@@ -121,14 +121,15 @@ Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& p
             const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
             const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
             const TDF_Label root = shapes->AddShape(shape, false);
+            const auto color = [](std::uint32_t rgb) {
+                return Quantity_Color(((rgb >> 16) & 0xFF) / 255.0, ((rgb >> 8) & 0xFF) / 255.0,
+                                      (rgb & 0xFF) / 255.0, Quantity_TOC_sRGB);
+            };
+            colors->SetColor(root, color(options.shape_color), XCAFDoc_ColorSurf);
             for (const auto& [face, rgb] : options.face_colors) {
                 const TDF_Label sub = shapes->AddSubShape(root, face);
                 if (sub.IsNull()) continue;
-                colors->SetColor(
-                    sub,
-                    Quantity_Color(((rgb >> 16) & 0xFF) / 255.0, ((rgb >> 8) & 0xFF) / 255.0,
-                                   (rgb & 0xFF) / 255.0, Quantity_TOC_sRGB),
-                    XCAFDoc_ColorSurf);
+                colors->SetColor(sub, color(rgb), XCAFDoc_ColorSurf);
             }
             STEPCAFControl_Writer writer;
             writer.SetColorMode(true);

@@ -29,6 +29,8 @@ struct StepWriteOptions {
     /// Face colors (0xRRGGBB, sRGB), written through XDE (STEPCAFControl_Writer) as surface
     /// styles; empty: plain geometry.
     std::vector<std::pair<TopoDS_Face, std::uint32_t>> face_colors;
+    /// The whole shape's color (faces without one of their own show it), with face_colors.
+    std::uint32_t shape_color = 0x9E9E9E;
 };
 
 /// Writes `shape` to `path` atomically (a temporary file in the same folder, then a rename).
