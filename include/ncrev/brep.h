@@ -105,6 +105,9 @@ struct ReverseReport {
     std::optional<SegmentResult> segmentation;
     std::vector<ReverseFallback> fallbacks;
     std::uint64_t fallback_faces = 0;                     ///< planar faces of the fallback regions
+    /// Regions whose own face failed and whose facets joined a neighbour's face (slivers that
+    /// lie on the neighbour's surface).
+    std::uint64_t absorbed_regions = 0;
     std::map<std::string, std::uint64_t> edges_by_curve;  ///< intersection, fitted, polyline
     std::uint64_t corners = 0;
     double max_corner_residual = 0;  ///< largest distance of a solved corner from its surfaces

@@ -7,8 +7,7 @@
 #include <TopExp.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
+#include <numeric>
 
 #include "brep/deviation.h"
 #include "brep/planar.h"
@@ -212,10 +211,6 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             if (points[r].empty()) continue;
             FitInput in;
             in.points = points[r];
-            if (std::getenv("NCREV_DEBUG")) {
-                std::fprintf(stderr, "region %zu bspline max %g, %zu points\n", r,
-                             sr.regions[r].fit.max, points[r].size());
-            }
             // The tightest of tolerance x 1, 4, 16 ... that a net reaches.
             for (double tol = sr.tolerance; tol < sr.regions[r].fit.max; tol *= 4) {
                 FitResult f = fit_bspline(in, tol);
@@ -239,12 +234,48 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                 std::to_string(g.fit.max) + " (tolerance " + std::to_string(sr.tolerance) + ")";
         }
     }
+    // One face per connected piece: a region in several pieces (segmentation joins every
+    // facet that one surface fits, and border refinement can detach a few) becomes one region
+    // per piece, each with the region's surface; `origin` maps them back.
+    FaceMap<std::int32_t> labels = sr.region;
+    std::vector<std::size_t> origin(sr.regions.size());
+    std::iota(origin.begin(), origin.end(), std::size_t{0});
+    {
+        std::vector<std::uint8_t> seen(mesh.num_faces(), 0), kept(sr.regions.size(), 0);
+        std::vector<FaceId> stack;
+        for (std::uint32_t f0 = 0; f0 < mesh.num_faces(); ++f0) {
+            if (seen[f0]) continue;
+            const std::int32_t r = sr.region[FaceId(f0)];
+            std::int32_t id = r;
+            if (kept[static_cast<std::size_t>(r)]) {
+                id = static_cast<std::int32_t>(origin.size());
+                origin.push_back(static_cast<std::size_t>(r));
+                surfaces.push_back(surfaces[static_cast<std::size_t>(r)]);
+            }
+            kept[static_cast<std::size_t>(r)] = 1;
+            seen[f0] = 1;
+            stack.assign(1, FaceId(f0));
+            while (!stack.empty()) {
+                const FaceId f = stack.back();
+                stack.pop_back();
+                labels[f] = id;
+                for (int i = 0; i < 3; ++i) {
+                    const HalfedgeId t = mesh.twin(Mesh::halfedge(f, i));
+                    if (!t.is_valid()) continue;
+                    const FaceId g = Mesh::face(t);
+                    if (seen[g.idx()] || sr.region[g] != r) continue;
+                    seen[g.idx()] = 1;
+                    stack.push_back(g);
+                }
+            }
+        }
+    }
     brep_detail::SurfaceBrepOptions bo;
     bo.tolerance = sr.tolerance;
     bo.chordal_deflection = std::max(sr.chordal_deflection, sr.tolerance);
     bo.allow_fallback = options.method == ReverseMethod::kAuto;
     brep_detail::SurfaceBrep brep;
-    stage("brep", [&] { brep = brep_detail::build_surface_brep(mesh, sr.region, surfaces, bo); });
+    stage("brep", [&] { brep = brep_detail::build_surface_brep(mesh, labels, surfaces, bo); });
     rep.corners = brep.corners;
     rep.max_corner_residual = brep.max_corner_residual;
     rep.max_tolerance = brep.max_tolerance;
@@ -254,17 +285,20 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                           {"polyline", brep.polyline_edges}};
     for (std::size_t r = 0; r < brep.regions.size(); ++r) {
         const brep_detail::RegionBuild& b = brep.regions[r];
-        if (b.fallback) {
+        const Region& g = sr.regions[origin[r]];
+        if (b.absorbed_into >= 0) {
+            ++rep.absorbed_regions;
+        } else if (b.fallback) {
             ReverseFallback fb;
-            fb.region = static_cast<std::int32_t>(r);
-            fb.facets = sr.regions[r].facets;
-            fb.kind = sr.regions[r].fit.ok ? to_string(sr.regions[r].fit.surface.kind) : "none";
+            fb.region = static_cast<std::int32_t>(origin[r]);
+            fb.facets = b.faces.size();
+            fb.kind = g.fit.ok ? to_string(g.fit.surface.kind) : "none";
             fb.reason = b.reason;
             rep.fallback_faces += b.faces.size();
             rep.fallbacks.push_back(std::move(fb));
             rep.faces_by_kind["facet"] += b.faces.size();
         } else if (!b.faces.empty()) {
-            rep.faces_by_kind[to_string(sr.regions[r].fit.surface.kind)] += b.faces.size();
+            rep.faces_by_kind[to_string(g.fit.surface.kind)] += b.faces.size();
         }
     }
     rep.solid = brep.solid;
@@ -341,14 +375,14 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             const std::vector<std::int64_t> tool = region_colors(mesh, *rep.segmentation);
             for (std::size_t r = 0; r < brep.regions.size(); ++r) {
                 const brep_detail::RegionBuild& b = brep.regions[r];
+                const std::int64_t t = tool[origin[r]];
                 const std::uint32_t rgb =
-                    tool[r] >= 0 ? static_cast<std::uint32_t>(tool[r] & 0xFFFFFF)
-                    : b.fallback
-                        ? kind_color("facet")
-                        : kind_color(to_string(rep.segmentation->regions[r].fit.surface.kind));
-                // Fallback facets take the shape's color (below): thousands of colored
+                    t >= 0 ? static_cast<std::uint32_t>(t & 0xFFFFFF)
+                           : kind_color(
+                                 to_string(rep.segmentation->regions[origin[r]].fit.surface.kind));
+                // Fallback facets take the shape's color (set above): thousands of colored
                 // sub-shapes would cost more than the rest of the STEP.
-                if (b.fallback && tool[r] < 0) continue;
+                if (b.fallback && t < 0) continue;
                 for (const TopoDS_Face& f : b.faces) w.face_colors.emplace_back(f, rgb);
             }
         }

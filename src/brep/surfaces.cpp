@@ -70,8 +70,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <numbers>
 #include <sstream>
 #include <unordered_map>
@@ -657,7 +655,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     SurfaceBrep out;
     const std::size_t nr = regions.size();
     out.regions.assign(nr, {});
-    Builder bd(m, region, regions, opt);
+    // The labels, changed where a failing region is absorbed by a neighbour.
+    FaceMap<std::int32_t> labels = region;
+    Builder bd(m, labels, regions, opt);
     bd.prepare();
     const RegionBorders& borders = bd.borders;
     const double max_tol = std::max(opt.chordal_deflection, 10 * opt.tolerance);
@@ -672,26 +672,86 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         out.regions[r].fallback = true;
         out.regions[r].reason = std::move(why);
     };
-    for (std::size_t r = 0; r < nr; ++r) {
-        if (!regions[r].has_surface) {
-            fall_back(r, regions[r].no_surface_reason.empty() ? "no surface fits the region"
-                                                              : regions[r].no_surface_reason);
-            continue;
+    std::vector<std::int32_t> absorbed(nr, -1);
+    const auto compute_geometry = [&] {
+        for (std::size_t r = 0; r < nr; ++r) {
+            if (absorbed[r] >= 0 || fallback[r]) continue;
+            if (!regions[r].has_surface) {
+                fall_back(r, regions[r].no_surface_reason.empty() ? "no surface fits the region"
+                                                                  : regions[r].no_surface_reason);
+                continue;
+            }
+            std::string why;
+            try {
+                geom[r] = geom_surface(regions[r].surface, bd.shapes[r], why);
+                if (!geom[r].IsNull()) sense[r] = natural_sense(geom[r], m, bd.shapes[r]);
+            } catch (const Standard_Failure& f) {
+                geom[r].Nullify();
+                why = std::string("OpenCASCADE cannot make the surface: ") + f.GetMessageString();
+            }
+            if (geom[r].IsNull()) fall_back(r, "no OpenCASCADE surface: " + why);
+            if (!fallback[r] && bd.loops[r].empty() &&
+                regions[r].surface.kind != FitKind::kSphere &&
+                regions[r].surface.kind != FitKind::kTorus) {
+                fall_back(r, "a region without a border on an open surface");
+            }
         }
-        std::string why;
-        try {
-            geom[r] = geom_surface(regions[r].surface, bd.shapes[r], why);
-            if (!geom[r].IsNull()) sense[r] = natural_sense(geom[r], m, bd.shapes[r]);
-        } catch (const Standard_Failure& f) {
-            geom[r].Nullify();
-            why = std::string("OpenCASCADE cannot make the surface: ") + f.GetMessageString();
+    };
+    compute_geometry();
+    // A failing region whose facets are all chords of a neighbour's surface (vertices within
+    // twice the tolerance, middles within the chordal deflection, normals agreeing): a sliver
+    // segmentation cut off a face (a strip along a fillet's tangent line, an island). It joins
+    // that neighbour instead of coming back as facets.
+    const double cos_normal = std::cos(kSegmentNormalAngle);
+    const auto try_absorb = [&](std::size_t r) -> bool {
+        if (!opt.allow_fallback || absorbed[r] >= 0) return false;
+        std::vector<std::int32_t> neighbours;
+        for (const BorderChain& ch : bd.borders.chains) {
+            if (ch.left == static_cast<std::int32_t>(r) && ch.right >= 0) {
+                neighbours.push_back(ch.right);
+            }
+            if (ch.right == static_cast<std::int32_t>(r)) neighbours.push_back(ch.left);
         }
-        if (geom[r].IsNull()) fall_back(r, "no OpenCASCADE surface: " + why);
-        if (!fallback[r] && bd.loops[r].empty() && regions[r].surface.kind != FitKind::kSphere &&
-            regions[r].surface.kind != FitKind::kTorus) {
-            fall_back(r, "a region without a border on an open surface");
+        std::sort(neighbours.begin(), neighbours.end());
+        neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
+        std::int32_t best = -1;
+        double best_worst = 1e300;
+        for (std::int32_t n : neighbours) {
+            const auto k = static_cast<std::size_t>(n);
+            if (fallback[k] || absorbed[k] >= 0 || !regions[k].has_surface) continue;
+            const Surface& su = regions[k].surface;
+            double worst = 0;
+            bool chords = true;
+            for (std::uint32_t f = 0; f < m.num_faces() && chords; ++f) {
+                const FaceId id(f);
+                if (labels[id] != static_cast<std::int32_t>(r)) continue;
+                Vec3 c{};
+                for (int i = 0; i < 3; ++i) {
+                    const Vec3 p = m.position(m.vertex(id, i));
+                    worst = std::max(worst, distance(su, p));
+                    c = c + (1.0 / 3) * p;
+                }
+                chords = worst <= 2 * opt.tolerance &&
+                         distance(su, c) <= opt.chordal_deflection + opt.tolerance &&
+                         std::abs(dot(normal_at(su, c), m.face_normal(id))) >= cos_normal;
+            }
+            if (chords && worst < best_worst) {
+                best = n;
+                best_worst = worst;
+            }
         }
-    }
+        if (best < 0) return false;
+        for (std::uint32_t f = 0; f < m.num_faces(); ++f) {
+            if (labels[FaceId(f)] == static_cast<std::int32_t>(r)) labels[FaceId(f)] = best;
+        }
+        absorbed[r] = best;
+        return true;
+    };
+    // After absorbing: borders, loops and the neighbours' geometry again.
+    const auto relabelled = [&] {
+        bd.prepare();
+        compute_geometry();
+    };
     if (!opt.allow_fallback) {
         for (std::size_t r = 0; r < nr; ++r) {
             if (fallback[r]) {
@@ -704,7 +764,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     // Regions around every mesh vertex that is a corner or a loop's start.
     const auto regions_at = [&](VertexId v) {
         std::vector<std::int32_t> rs;
-        m.for_each_outgoing(v, [&](HalfedgeId h) { rs.push_back(region[Mesh::face(h)]); });
+        m.for_each_outgoing(v, [&](HalfedgeId h) { rs.push_back(labels[Mesh::face(h)]); });
         std::sort(rs.begin(), rs.end());
         rs.erase(std::unique(rs.begin(), rs.end()), rs.end());
         return rs;
@@ -771,9 +831,6 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             const TopoDS_Vertex va = plain_vertex(VertexId(lo)), vb = plain_vertex(VertexId(hi));
             BRepBuilderAPI_MakeEdge me(va, vb);
             TopoDS_Edge e = me.IsDone() ? me.Edge() : TopoDS_Edge();
-            if (e.IsNull() && std::getenv("NCREV_DEBUG")) {
-                std::fprintf(stderr, "null segment %u %u\n", lo, hi);
-            }
             segment.emplace(key, e);
             return e;
         };
@@ -856,20 +913,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                                                     1.01 * e1.Distance(BRep_Tool::Pnt(V1))));
                         BRepBuilderAPI_MakeEdge me(cc.curve, V0, V1, cc.first, cc.last);
                         ok = me.IsDone();
-                        if (!ok && std::getenv("NCREV_DEBUG")) {
-                            std::fprintf(stderr, "make edge %d: %s %g %g periodic %d\n",
-                                         static_cast<int>(me.Error()),
-                                         cc.curve->DynamicType()->Name(), cc.first, cc.last,
-                                         static_cast<int>(cc.curve->IsPeriodic()));
-                        }
                         if (ok) {
                             TopoDS_Edge e = me.Edge();
                             B.UpdateEdge(e, std::max(kMinTolerance, 1.01 * cc.deviation));
-                            if (std::getenv("NCREV_DEBUG")) {
-                                std::fprintf(stderr, "chain %zu (%d|%d) %s dev %g n %zu sin %g\n",
-                                             c, ch.left, ch.right, intersected ? "int" : "fit",
-                                             cc.deviation, ch.vertices.size(), min_sin);
-                            }
                             chain_edges[c].push_back(e);
                             ++(intersected ? out.intersection_edges : out.fitted_edges);
                         }
@@ -878,11 +924,6 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     ok = false;
                 }
                 if (ok) continue;
-                if (std::getenv("NCREV_DEBUG")) {
-                    std::fprintf(stderr, "chain %zu (%d|%d) closed %d n %zu min_sin %g dev %g\n", c,
-                                 ch.left, ch.right, ch.closed, ch.vertices.size(), min_sin,
-                                 cc.deviation);
-                }
                 failed_chain.push_back(static_cast<std::int32_t>(c));
             }
             // The chain's own segments.
@@ -897,6 +938,21 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         // A chain without a curve between two surfaces: both regions become facets, since
         // a polyline edge may lie off a curved surface by more than its tolerance allows.
         bool changed = false;
+        bool chain_absorbed = false;
+        for (std::int32_t c : failed_chain) {
+            const BorderChain& ch = borders.chains[static_cast<std::size_t>(c)];
+            for (std::int32_t r : {ch.left, ch.right}) {
+                if (r >= 0 && absorbed[static_cast<std::size_t>(ch.left)] < 0 &&
+                    (ch.right < 0 || absorbed[static_cast<std::size_t>(ch.right)] < 0) &&
+                    try_absorb(static_cast<std::size_t>(r))) {
+                    chain_absorbed = true;
+                }
+            }
+        }
+        if (chain_absorbed) {
+            relabelled();
+            continue;
+        }
         for (std::int32_t c : failed_chain) {
             const BorderChain& ch = borders.chains[static_cast<std::size_t>(c)];
             for (std::int32_t r : {ch.left, ch.right}) {
@@ -917,7 +973,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         std::vector<std::vector<TopoDS_Face>> faces(nr);
         std::vector<std::pair<std::size_t, std::string>> failed_region;
         for (std::size_t r = 0; r < nr; ++r) {
-            if (fallback[r]) continue;
+            if (fallback[r] || bd.facets[r] == 0) continue;
             try {
                 TopoDS_Face F;
                 if (bd.loops[r].empty()) {
@@ -980,25 +1036,6 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 }
                 if (sense[r] < 0) F.Reverse();
                 if (std::string why = check_failure(F); !why.empty()) {
-                    if (std::getenv("NCREV_DEBUG")) {
-                        const Surface& su = regions[r].surface;
-                        std::fprintf(stderr,
-                                     "region %zu %s p %g %g %g a %g %g %g r %g sense %d loops "
-                                     "%zu: %s\n",
-                                     r, to_string(su.kind), su.point.x, su.point.y, su.point.z,
-                                     su.axis.x, su.axis.y, su.axis.z, su.radius, sense[r],
-                                     bd.loops[r].size(), why.c_str());
-                        for (const auto& loop : bd.loops[r]) {
-                            std::fprintf(stderr, "  loop:");
-                            for (const auto& [c, fwd] : loop) {
-                                const BorderChain& ch = borders.chains[static_cast<std::size_t>(c)];
-                                std::fprintf(stderr, " %d%s(%d|%d n%zu%s)", c, fwd ? "+" : "-",
-                                             ch.left, ch.right, ch.vertices.size(),
-                                             ch.closed ? " closed" : "");
-                            }
-                            std::fprintf(stderr, "\n");
-                        }
-                    }
                     failed_region.emplace_back(r,
                                                "its face fails OpenCASCADE's check (" + why + ")");
                     continue;
@@ -1015,7 +1052,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         }
         for (std::uint32_t fi = 0; fi < m.num_faces(); ++fi) {
             const FaceId f(fi);
-            const auto r = static_cast<std::size_t>(region[f]);
+            const auto r = static_cast<std::size_t>(labels[f]);
             if (!fallback[r]) continue;
             TopoDS_Wire W;
             B.MakeWire(W);
@@ -1030,10 +1067,10 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             const gp_Pnt p1 = BRep_Tool::Pnt(plain_vertex(m.vertex(f, 1)));
             const gp_Pnt p2 = BRep_Tool::Pnt(plain_vertex(m.vertex(f, 2)));
             const gp_Vec n = gp_Vec(p0, p1).Crossed(gp_Vec(p0, p2));
-            if (n.Magnitude() <= 0) {
-                if (std::getenv("NCREV_DEBUG")) std::fprintf(stderr, "zero facet %u\n", fi);
-                continue;
-            }
+            // Healing leaves no zero-area facet; one whose corner was solved onto another's
+            // place leaves its neighbours' edges unpaired, which the closed-shell check
+            // below turns into further fallbacks.
+            if (n.Magnitude() <= 0) continue;
             TopoDS_Face F;
             B.MakeFace(F, new Geom_Plane(p0, gp_Dir(n)), kMinTolerance);
             B.Add(F, W);
@@ -1049,6 +1086,12 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             // with it (their shared edges zigzag); once the sliver is facets, the neighbour's
             // face usually builds. Regions more than 4x larger than the smallest failing one
             // get another round (all of them in the last).
+            bool absorbed_any = false;
+            for (const auto& [r, why] : failed_region) absorbed_any = try_absorb(r) || absorbed_any;
+            if (absorbed_any) {
+                relabelled();
+                continue;
+            }
             std::size_t smallest = SIZE_MAX;
             for (const auto& [r, why] : failed_region) {
                 smallest = std::min(smallest, bd.facets[r]);
@@ -1081,12 +1124,6 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 continue;
             closed = false;
             for (const TopoDS_Shape& f : edge_faces.FindFromIndex(i)) open_faces.push_back(f);
-            if (std::getenv("NCREV_DEBUG")) {
-                const TopoDS_Vertex a = TopExp::FirstVertex(e), b = TopExp::LastVertex(e);
-                const gp_Pnt pa = BRep_Tool::Pnt(a), pb = BRep_Tool::Pnt(b);
-                std::fprintf(stderr, "open edge: %d faces, %g %g %g -> %g %g %g\n", n, pa.X(),
-                             pa.Y(), pa.Z(), pb.X(), pb.Y(), pb.Z());
-            }
         }
         for (std::size_t r = 0; r < nr; ++r) {
             out.regions[r].faces.clear();
@@ -1129,19 +1166,30 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             if (i == 0) continue;
             for (const TopoDS_Shape& f : anc.FindFromIndex(i)) bad_faces.Add(f);
         }
-        bool more = false;
+        std::vector<std::size_t> bad_regions;
         for (std::size_t r = 0; r < nr; ++r) {
             if (fallback[r]) continue;
             for (const TopoDS_Face& f : out.regions[r].faces) {
                 if (bad_faces.Contains(f) || bad_faces.Contains(f.Reversed())) {
-                    fall_back(r, "the solid fails OpenCASCADE's check at its face (" + why + ")");
-                    more = true;
+                    bad_regions.push_back(r);
                     break;
                 }
             }
         }
-        if (!more) break;
+        if (bad_regions.empty()) break;
+        bool solid_absorbed = false;
+        for (std::size_t r : bad_regions) {
+            if (bd.facets[r] > 0) solid_absorbed = try_absorb(r) || solid_absorbed;
+        }
+        if (solid_absorbed) {
+            relabelled();
+            continue;
+        }
+        for (std::size_t r : bad_regions) {
+            fall_back(r, "the solid fails OpenCASCADE's check at its face (" + why + ")");
+        }
     }
+    for (std::size_t r = 0; r < nr; ++r) out.regions[r].absorbed_into = absorbed[r];
     // Largest tolerance.
     if (!out.shape.IsNull()) {
         for (TopExp_Explorer x(out.shape, TopAbs_VERTEX); x.More(); x.Next()) {

@@ -37,6 +37,9 @@ struct RegionBuild {
     bool fallback = false;           ///< built as its facets
     std::string reason;              ///< why, when `fallback`
     std::vector<TopoDS_Face> faces;  ///< the faces it became (one, or its facets)
+    /// The region whose face took its facets (a sliver whose own face failed and whose facets
+    /// are chords of that neighbour's surface); -1 when not absorbed.
+    std::int32_t absorbed_into = -1;
 };
 
 struct SurfaceBrep {

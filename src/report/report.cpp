@@ -189,6 +189,7 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
         }
         r["fallbacks"] = fallbacks;
         r["fallback_faces"] = rev.fallback_faces;
+        r["absorbed_regions"] = rev.absorbed_regions;
         r["edges_by_curve"] = rev.edges_by_curve;
         r["corners"] = rev.corners;
         r["max_corner_residual"] = rev.max_corner_residual;
