@@ -282,15 +282,19 @@ SamplePart corpus_part(const std::filesystem::path& path) {
     return std::move(made).value();
 }
 
-// Real parts: prismatic ones come back face for face.
-TEST(ReverseSurfaces, PrismaticCorpusPartsFaceForFace) {
+// Real parts: the MFCAD feature models and NIST CTC 03 come back face for face, NIST FTC 09
+// (158 faces: planes, cylinders, cones) within one face; each a valid closed solid.
+TEST(ReverseSurfaces, RealPartsFaceForFace) {
     if (corpus_steps().empty()) GTEST_SKIP() << "no corpus at " << corpus_step_dir();
-    for (const char* name :
-         {"mfcad_2-3-3-3-3-23.step", "mfcad_4-5-6-13-19.step", "nist_ctc_01_asme1_rd.stp"}) {
+    for (const char* name : {"mfcad_2-3-3-3-3-23.step", "mfcad_4-5-6-13-19.step",
+                             "nist_ctc_03_asme1_rc.stp", "nist_ftc_09_asme1_rd.stp"}) {
         const Outcome o =
             reverse_part(corpus_part(corpus_step_dir() / name), false, ReverseMethod::kAuto, name);
         expect_solid(o, name);
-        EXPECT_EQ(o.report.faces, o.true_faces) << name;
+        EXPECT_LE(std::abs(static_cast<double>(o.report.faces) - static_cast<double>(o.true_faces)),
+                  1.0)
+            << name;
+        EXPECT_TRUE(o.report.fallbacks.empty()) << name;
         EXPECT_NEAR(o.report.solid_volume, o.true_volume, 1e-3 * o.true_volume) << name;
     }
 }
