@@ -104,7 +104,7 @@ struct ReverseReport {
     /// fallbacks, the B-rep's edges by how their curve was made, and its largest tolerance.
     std::optional<SegmentResult> segmentation;
     std::vector<ReverseFallback> fallbacks;
-    std::uint64_t fallback_faces = 0;                     ///< planar faces of the fallback regions
+    std::uint64_t fallback_faces = 0;  ///< planar faces of the fallback regions
     /// Regions whose own face failed and whose facets joined a neighbour's face (slivers that
     /// lie on the neighbour's surface).
     std::uint64_t absorbed_regions = 0;
