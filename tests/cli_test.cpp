@@ -5,11 +5,14 @@
 #include <unistd.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "ncrev/curvature.h"
 #include "ncrev/io.h"
@@ -165,6 +168,51 @@ TEST(CliReverse, OpenMeshWithRequireSolidExitsThreeAndWritesNothing) {
     EXPECT_NE(shell.err.find("warning: the mesh is open"), std::string::npos) << shell.err;
     std::filesystem::remove(step);
     std::filesystem::remove(stl);
+}
+
+// The default method on the bundled example: the true faces, the extended report, labels in
+// input order and the regions PLY; --method surfaces refuses an open mesh (exit 3).
+TEST(CliReverse, AutoGivesTheTrueFacesWithLabelsSegmentsAndReport) {
+    const auto stl = std::filesystem::path(NCREV_SOURCE_DIR) / "examples" / "pocket_block.stl";
+    const auto dir = std::filesystem::temp_directory_path();
+    const auto step = dir / "ncrev_cli_auto.step", labels = dir / "ncrev_cli_auto.labels",
+               ply = dir / "ncrev_cli_auto.ply";
+    const CliRun r = run("reverse " + stl.string() + " -o " + step.string() + " --labels " +
+                         labels.string() + " --segments " + ply.string() + " --json -q");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    const auto& rev = j["reverse"];
+    EXPECT_EQ(rev["method"], "auto");
+    EXPECT_EQ(rev["faces"], 27);
+    EXPECT_EQ(rev["regions"], 27);
+    EXPECT_EQ(rev["faces_by_kind"]["torus"], 4);
+    EXPECT_TRUE(rev["fallbacks"].empty());
+    EXPECT_EQ(rev["closed_valid_solid"], true);
+    EXPECT_LT(std::abs(rev["volume_difference"].get<double>()), 1e-3);
+    EXPECT_GT(rev["deviation"]["mesh_to_solid"]["points"].get<int>(), 0);
+    EXPECT_LT(rev["deviation"]["mesh_to_solid"]["max"].get<double>(),
+              2 * rev["segment"]["chordal_deflection"].get<double>());
+    std::ifstream in(labels);
+    std::set<int> ids;
+    std::size_t lines = 0;
+    for (int id = 0; in >> id; ++lines) ids.insert(id);
+    EXPECT_EQ(lines, 900u);
+    EXPECT_EQ(ids.size(), 27u);
+    EXPECT_GT(std::filesystem::file_size(ply), 900u * 13u);
+    EXPECT_EQ(
+        run("reverse " + stl.string() + " -o " + step.string() + " --labels " + stl.string()).code,
+        1);
+    for (const auto& p : {step, labels, ply}) std::filesystem::remove(p);
+
+    auto c = test::cube({0, 0, 0}, 10.0);
+    c.triangles.pop_back();
+    const auto open =
+        write_temp("ncrev_cli_surfaces_open.stl", encode_stl_binary(c.points, c.triangles));
+    const CliRun s =
+        run("reverse " + open.string() + " -o " + step.string() + " --method surfaces");
+    EXPECT_EQ(s.code, 3);
+    EXPECT_FALSE(std::filesystem::exists(step));
+    std::filesystem::remove(open);
 }
 
 /// The vertex records of a PLY written by `ncrev curvature`, after checking its header.

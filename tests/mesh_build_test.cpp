@@ -135,6 +135,31 @@ TEST(MeshBuild, RemovesDegenerateFacets) {
     EXPECT_TRUE(s.closed);
 }
 
+// A cap stitched into the surface (a T-junction's zero-area facet, as CAD tessellations make
+// them) is removed by splitting the facet beyond its long edge: no crack opens.
+TEST(MeshBuild, SplitsStitchedCapsInsteadOfOpeningACrack) {
+    auto m = test::cube();
+    // Facet 0 (a, b, x): split its edge a-b at the midpoint c into (a, c, x) and (c, b, x),
+    // then close the T-junction with the cap (a, b, c).
+    const auto t = m.triangles[0];
+    const std::uint32_t a = t[0], b = t[1], x = t[2];
+    const Vec3 pa = m.points[a], pb = m.points[b];
+    m.points.push_back(0.5 * (pa + pb));
+    const auto c = static_cast<std::uint32_t>(m.points.size() - 1);
+    m.triangles[0] = {a, c, x};
+    m.triangles.push_back({c, b, x});
+    m.triangles.push_back({a, b, c});
+    auto built = build_ok(test::to_bucket(m));
+    EXPECT_EQ(built.heal.degenerate_facets_removed, 1u);
+    EXPECT_EQ(built.heal.caps_split, 1u);
+    const MeshStats s = compute_stats(built.mesh);
+    EXPECT_TRUE(s.closed);
+    EXPECT_EQ(s.faces, 14u);  // 12 + 1 (facet 0 split) + 1 (the facet beyond a-b split)
+    EXPECT_EQ(s.vertices, 9u);
+    EXPECT_NEAR(s.volume, 1.0, 1e-12);
+    EXPECT_EQ(built.mesh.validate(), "");
+}
+
 TEST(MeshBuild, FindsHolesAsBoundaryLoops) {
     auto m = test::cube();
     m.triangles.erase(m.triangles.begin() + 2, m.triangles.begin() + 4);  // the top square
