@@ -70,6 +70,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <numbers>
 #include <sstream>
 #include <unordered_map>
@@ -673,6 +674,8 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         out.regions[r].reason = std::move(why);
     };
     std::vector<std::int32_t> absorbed(nr, -1);
+    // Regions whose tangent junctions take piecewise-linear edges (after a self-crossing wire).
+    std::vector<std::uint8_t> linear(nr, 0);
     const auto compute_geometry = [&] {
         for (std::size_t r = 0; r < nr; ++r) {
             if (absorbed[r] >= 0 || fallback[r]) continue;
@@ -899,6 +902,15 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                                 continue;
                             }
                             t.deviation = curve_off_surfaces(t, sa, sb, samples);
+                            // A region whose wire crossed itself gets the piecewise-linear
+                            // curve along its tangent junctions: a cubic through many close
+                            // points wiggles across the tangency band, and its curve on the
+                            // flat neighbour can cross the next edge's near their vertex.
+                            if (variant == 2 && (linear[ra] || linear[rb]) &&
+                                min_sin <= std::sin(kTangentAngle) && t.deviation <= max_tol) {
+                                best = t;
+                                break;
+                            }
                             if (best.deviation < 0 || t.deviation < best.deviation) best = t;
                         }
                         ok = best.deviation >= 0 && best.deviation <= max_tol;
@@ -1086,6 +1098,14 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             // with it (their shared edges zigzag); once the sliver is facets, the neighbour's
             // face usually builds. Regions more than 4x larger than the smallest failing one
             // get another round (all of them in the last).
+            bool retry = false;
+            for (const auto& [r, why] : failed_region) {
+                if (!linear[r] && why.find("SelfIntersectingWire") != std::string::npos) {
+                    linear[r] = 1;
+                    retry = true;
+                }
+            }
+            if (retry) continue;
             bool absorbed_any = false;
             for (const auto& [r, why] : failed_region) absorbed_any = try_absorb(r) || absorbed_any;
             if (absorbed_any) {
@@ -1125,6 +1145,28 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             closed = false;
             for (const TopoDS_Shape& f : edge_faces.FindFromIndex(i)) open_faces.push_back(f);
         }
+        // Faces that run along a shared edge in the same direction (one of them turned
+        // inside out, e.g. by a wire the fix reversed): the shell cannot be oriented there.
+        {
+            std::map<const void*, std::pair<int, std::vector<TopoDS_Shape>>> use;
+            for (TopExp_Explorer fx(fixed, TopAbs_FACE); fx.More(); fx.Next()) {
+                for (TopExp_Explorer ex(fx.Current(), TopAbs_EDGE); ex.More(); ex.Next()) {
+                    const TopoDS_Edge& e = TopoDS::Edge(ex.Current());
+                    if (BRep_Tool::Degenerated(e) ||
+                        BRep_Tool::IsClosed(e, TopoDS::Face(fx.Current()))) {
+                        continue;
+                    }
+                    auto& [balance, fs] = use[e.TShape().get()];
+                    balance += e.Orientation() == TopAbs_FORWARD ? 1 : -1;
+                    fs.push_back(fx.Current());
+                }
+            }
+            for (const auto& [key, u] : use) {
+                if (u.first == 0 || u.second.size() != 2) continue;
+                closed = false;
+                for (const TopoDS_Shape& f : u.second) open_faces.push_back(f);
+            }
+        }
         for (std::size_t r = 0; r < nr; ++r) {
             out.regions[r].faces.clear();
             for (const TopoDS_Face& f : faces[r]) {
@@ -1148,8 +1190,8 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         out.shape = result;
         out.solid = closed;
         std::vector<TopoDS_Shape> bad = open_faces;
-        const std::string why =
-            closed ? check_failure(result, &bad) : std::string("the shell is not closed");
+        const std::string why = closed ? check_failure(result, &bad)
+                                       : std::string("the shell is not closed, or not orientable");
         out.valid = why.empty() && closed;
         if (!why.empty()) out.problem = closed ? "BRepCheck_Analyzer: " + why : why;
         if (out.valid || !opt.allow_fallback) break;
