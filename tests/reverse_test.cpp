@@ -28,6 +28,7 @@
 #include "ncrev/brep.h"
 #include "ncrev/io.h"
 #include "ncrev/sample.h"
+#include "sample_cases.h"
 #include "step_readback.h"
 
 namespace ncrev {
@@ -43,9 +44,8 @@ std::filesystem::path out_dir() {
     return dir;
 }
 
-constexpr double kFine = kSampleRelativeDeflection;
-constexpr double kCoarse = 4 * kSampleRelativeDeflection;
-constexpr double kCoarseAngular = 0.5;
+using test::kCoarse;
+using test::kFine;
 
 struct Outcome {
     ReverseReport report;
@@ -104,13 +104,7 @@ Outcome reverse_part(const SamplePart& part, bool sre, ReverseMethod method,
 }
 
 SamplePart make(std::string_view name, double relative) {
-    SampleOptions so;
-    so.with_step = false;
-    so.relative_deflection = relative;
-    if (relative > kSampleRelativeDeflection) so.angular_deflection = kCoarseAngular;
-    Result<SamplePart> made = make_sample_part(name, so);
-    EXPECT_TRUE(made.ok()) << name;
-    return std::move(made).value();
+    return test::sample_case(name, relative);
 }
 
 void expect_solid(const Outcome& o, const std::string& tag) {

@@ -18,6 +18,7 @@
 #include "analytic_shapes.h"
 #include "ncrev/mesh.h"
 #include "ncrev/sample.h"
+#include "sample_cases.h"
 
 namespace ncrev {
 namespace {
@@ -80,10 +81,8 @@ Score score(const Mesh& mesh, const SegmentResult& r, const SamplePart& part) {
     return s;
 }
 
-constexpr double kFine = kSampleRelativeDeflection;
-constexpr double kCoarse = 4 * kSampleRelativeDeflection;
-/// Coarse meshes also take larger normal steps (29 degrees, under the 30-degree sharp angle).
-constexpr double kCoarseAngular = 0.5;
+using test::kCoarse;
+using test::kFine;
 
 struct Case {
     SamplePart part;
@@ -91,15 +90,10 @@ struct Case {
 };
 
 Case make_case(std::string_view name, double relative_deflection) {
-    SampleOptions so;
-    so.with_step = false;
-    so.relative_deflection = relative_deflection;
-    if (relative_deflection > kSampleRelativeDeflection) so.angular_deflection = kCoarseAngular;
-    Result<SamplePart> made = make_sample_part(name, so);
-    EXPECT_TRUE(made.ok()) << name;
-    Result<BuildResult> b = build_mesh(made.value().mesh);
+    SamplePart part = test::sample_case(name, relative_deflection);
+    Result<BuildResult> b = build_mesh(part.mesh);
     EXPECT_TRUE(b.ok());
-    return {std::move(made).value(), std::move(b.value().mesh)};
+    return {std::move(part), std::move(b.value().mesh)};
 }
 
 Score run(const Case& c, SegmentMethod method) {

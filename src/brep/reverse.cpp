@@ -75,6 +75,22 @@ void run_stage(ReverseReport& rep, const ReverseOptions& options, const char* na
     if (options.progress) options.progress(name, 1.0);
 }
 
+brep_detail::StepWriteOptions step_write_options(const ReverseOptions& options) {
+    brep_detail::StepWriteOptions w;
+    w.schema = options.schema;
+    w.unit = options.unit;
+    w.product_name = options.product_name.empty() ? "ncrev" : options.product_name;
+    return w;
+}
+
+// The report of a written STEP file: `written`, and its size.
+ReverseReport mark_written(ReverseReport rep, const std::filesystem::path& output) {
+    rep.written = true;
+    std::error_code ec;
+    rep.step_bytes = std::filesystem::file_size(output, ec);
+    return rep;
+}
+
 Result<ReverseReport> reverse_planar(const Mesh& mesh, const MeshStats& stats,
                                      const std::filesystem::path& output,
                                      const ReverseOptions& options, ReverseReport rep) {
@@ -135,17 +151,10 @@ Result<ReverseReport> reverse_planar(const Mesh& mesh, const MeshStats& stats,
     }
     Status written = Ok{};
     stage("step", [&] {
-        brep_detail::StepWriteOptions w;
-        w.schema = options.schema;
-        w.unit = options.unit;
-        w.product_name = options.product_name.empty() ? "ncrev" : options.product_name;
-        written = brep_detail::write_planar_step(topo, mesh, output, w);
+        written = brep_detail::write_planar_step(topo, mesh, output, step_write_options(options));
     });
     if (!written) return written.error();
-    rep.written = true;
-    std::error_code ec;
-    rep.step_bytes = std::filesystem::file_size(output, ec);
-    return rep;
+    return mark_written(std::move(rep), output);
 }
 
 // The most frequent SRE color of each region's facets (-1 where the mesh has none).
@@ -366,10 +375,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     }
     Status written = Ok{};
     stage("step", [&] {
-        brep_detail::StepWriteOptions w;
-        w.schema = options.schema;
-        w.unit = options.unit;
-        w.product_name = options.product_name.empty() ? "ncrev" : options.product_name;
+        brep_detail::StepWriteOptions w = step_write_options(options);
         if (options.colors) {
             w.shape_color = kind_color("facet");
             const std::vector<std::int64_t> tool = region_colors(mesh, *rep.segmentation);
@@ -389,10 +395,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         written = brep_detail::write_step_file(brep.shape, output, w);
     });
     if (!written) return written.error();
-    rep.written = true;
-    std::error_code ec;
-    rep.step_bytes = std::filesystem::file_size(output, ec);
-    return rep;
+    return mark_written(std::move(rep), output);
 }
 
 }  // namespace
