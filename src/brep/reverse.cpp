@@ -344,13 +344,11 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                                " facets) built from its facets: " + fb.reason);
     }
     rep.segmentation = std::move(*seg);
-    if (!rep.valid && options.method == ReverseMethod::kAuto) {
-        // The last resort, so that a closed mesh always gives a valid closed solid: the whole
-        // part as planar faces (that construction cannot fail), reported as one fallback.
-        const std::string why = "the B-rep from the surfaces is invalid (" +
-                                (brep.problem.empty() ? std::string("unknown") : brep.problem) +
-                                "): the whole part is built with the planar method";
-        ReverseReport planar = rep;
+    // The last resort, so that a closed mesh always gives a valid closed solid: the whole part
+    // as planar faces (that construction cannot fail), reported as one fallback.
+    const auto whole_planar = [&](ReverseReport base,
+                                  const std::string& why) -> Result<ReverseReport> {
+        ReverseReport planar = std::move(base);
         planar.faces_by_kind.clear();
         planar.deviation.reset();
         planar.volume_difference = 0;
@@ -361,11 +359,19 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         all.kind = "all";
         all.reason = why;
         planar.fallbacks.push_back(all);
+        planar.written = false;
+        planar.step_bytes = 0;
         auto out = reverse_planar(mesh, stats, output, options, std::move(planar));
         if (out && out->solid && out->mesh_volume != 0) {
             out->volume_difference = (out->solid_volume - out->mesh_volume) / out->mesh_volume;
         }
         return out;
+    };
+    if (!rep.valid && options.method == ReverseMethod::kAuto) {
+        return whole_planar(rep,
+                            "the B-rep from the surfaces is invalid (" +
+                                (brep.problem.empty() ? std::string("unknown") : brep.problem) +
+                                "): the whole part is built with the planar method");
     }
     if (!rep.valid) {
         rep.warnings.push_back("the B-rep is invalid (" +
@@ -395,6 +401,23 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         written = brep_detail::write_step_file(brep.shape, output, w);
     });
     if (!written) return written.error();
+    // What a CAD system will see: the file read back (STEP keeps no tolerances; the reader
+    // derives them) must pass the check too.
+    std::string back_problem;
+    stage("verify", [&] { back_problem = brep_detail::step_reads_back_invalid(output); });
+    if (!back_problem.empty()) {
+        if (options.method == ReverseMethod::kAuto) {
+            return whole_planar(rep, "the STEP of the surfaces reads back invalid (" +
+                                         back_problem +
+                                         "): the whole part is built with the planar method");
+        }
+        std::error_code ec;
+        std::filesystem::remove(output, ec);
+        rep.valid = false;
+        rep.warnings.push_back("the STEP reads back invalid (" + back_problem +
+                               "): nothing written");
+        return rep;
+    }
     return mark_written(std::move(rep), output);
 }
 

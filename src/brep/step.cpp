@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <APIHeaderSection_MakeHeader.hxx>
+#include <BRepCheck_Analyzer.hxx>
 #include <Interface_Static.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
@@ -10,6 +11,7 @@
 #include <Quantity_Color.hxx>
 #include <STEPCAFControl_Writer.hxx>
 #include <STEPControl_Controller.hxx>
+#include <STEPControl_Reader.hxx>
 #include <STEPControl_Writer.hxx>
 #include <Standard_Failure.hxx>
 #include <StepBasic_Product.hxx>
@@ -17,6 +19,8 @@
 #include <TCollection_HAsciiString.hxx>
 #include <TDF_Label.hxx>
 #include <TDocStd_Document.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
@@ -161,6 +165,23 @@ Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& p
                            "cannot rename into place: " + ec.message());
     }
     return Ok{};
+}
+
+std::string step_reads_back_invalid(const std::filesystem::path& path) {
+    silence_occt();
+    try {
+        STEPControl_Reader reader;
+        if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) return "OpenCASCADE cannot read it";
+        reader.TransferRoots();
+        const TopoDS_Shape shape = reader.OneShape();
+        TopTools_IndexedMapOfShape solids;
+        TopExp::MapShapes(shape, TopAbs_SOLID, solids);
+        if (solids.Extent() != 1) return std::to_string(solids.Extent()) + " solids";
+        if (!BRepCheck_Analyzer(shape).IsValid()) return "BRepCheck_Analyzer finds defects";
+    } catch (const Standard_Failure& f) {
+        return std::string("OpenCASCADE fails reading it: ") + f.GetMessageString();
+    }
+    return {};
 }
 
 }  // namespace ncrev::brep_detail

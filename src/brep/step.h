@@ -39,4 +39,8 @@ struct StepWriteOptions {
 Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& path,
                        const StepWriteOptions& options);
 
+/// Reads `path` back with OpenCASCADE's STEP reader and checks it: empty when it holds one
+/// solid that passes BRepCheck_Analyzer, else what is wrong.
+std::string step_reads_back_invalid(const std::filesystem::path& path);
+
 }  // namespace ncrev::brep_detail
