@@ -351,6 +351,8 @@ TEST(ReverseStudy, DISABLED_Corpus) {
         SampleOptions so;
         so.with_step = false;
         so.relative_deflection = 1e-3;
+        if (const char* d = std::getenv("DEFLECTION")) so.deflection = std::atof(d);  // mm
+        if (const char* a = std::getenv("ANGULAR")) so.angular_deflection = std::atof(a);
         Result<SamplePart> made = sample_from_step(path, so);
         if (!made.ok()) {
             std::printf("| %s | %s |\n", path.filename().string().c_str(),

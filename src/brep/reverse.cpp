@@ -402,9 +402,12 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     });
     if (!written) return written.error();
     // What a CAD system will see: the file read back (STEP keeps no tolerances; the reader
-    // derives them) must pass the check too.
+    // derives them) must pass the check too — up to kOcctCheckMaxFaces faces (reading and
+    // checking cost ~1 ms a face; larger B-reps are all but fallback facets).
     std::string back_problem;
-    stage("verify", [&] { back_problem = brep_detail::step_reads_back_invalid(output); });
+    if (rep.faces <= kOcctCheckMaxFaces) {
+        stage("verify", [&] { back_problem = brep_detail::step_reads_back_invalid(output); });
+    }
     if (!back_problem.empty()) {
         if (options.method == ReverseMethod::kAuto) {
             return whole_planar(rep, "the STEP of the surfaces reads back invalid (" +
