@@ -44,6 +44,8 @@ std::filesystem::path out_dir() {
     return dir;
 }
 
+using test::corpus_step_dir;
+using test::corpus_steps;
 using test::kCoarse;
 using test::kFine;
 
@@ -249,22 +251,6 @@ TEST(ReverseSurfaces, Deterministic) {
     const Outcome b = reverse_part(part, false, ReverseMethod::kAuto, "det_b");
     ASSERT_FALSE(a.step_text.empty());
     EXPECT_EQ(a.step_text, b.step_text);
-}
-
-std::filesystem::path corpus_step_dir() {
-    return std::filesystem::path(NCREV_SOURCE_DIR) / ".." / "shared" / "corpus" / "step";
-}
-
-std::vector<std::filesystem::path> corpus_steps() {
-    std::vector<std::filesystem::path> out;
-    if (!std::filesystem::is_directory(corpus_step_dir())) return out;
-    for (const auto& e : std::filesystem::directory_iterator(corpus_step_dir())) {
-        std::string ext = e.path().extension().string();
-        std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-        if (ext == ".step" || ext == ".stp") out.push_back(e.path());
-    }
-    std::sort(out.begin(), out.end());
-    return out;
 }
 
 SamplePart corpus_part(const std::filesystem::path& path) {

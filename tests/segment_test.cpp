@@ -81,6 +81,8 @@ Score score(const Mesh& mesh, const SegmentResult& r, const SamplePart& part) {
     return s;
 }
 
+using test::corpus_step_dir;
+using test::corpus_steps;
 using test::kCoarse;
 using test::kFine;
 
@@ -452,23 +454,6 @@ TEST(SegmentStudy, DISABLED_Noise) {
 
 namespace ncrev {
 namespace {
-
-std::filesystem::path corpus_step_dir() {
-    return std::filesystem::path(NCREV_SOURCE_DIR) / ".." / "shared" / "corpus" / "step";
-}
-
-/// The STEP files of the corpus, sorted.
-std::vector<std::filesystem::path> corpus_steps() {
-    std::vector<std::filesystem::path> out;
-    if (!std::filesystem::is_directory(corpus_step_dir())) return out;
-    for (const auto& e : std::filesystem::directory_iterator(corpus_step_dir())) {
-        const std::string ext = e.path().extension().string();
-        if (ext == ".step" || ext == ".stp" || ext == ".STEP" || ext == ".STP")
-            out.push_back(e.path());
-    }
-    std::sort(out.begin(), out.end());
-    return out;
-}
 
 // Prismatic real parts (the MFCAD feature models, two NIST test cases) come back face for face.
 TEST(Segment, FindsTheFacesOfPrismaticCorpusParts) {
