@@ -97,8 +97,6 @@ class TriangleGrid {
         if (tris_.empty()) return 0;
         std::array<int, 3> c{};
         for (int k = 0; k < 3; ++k) c[k] = index(coord(p, k), k);
-        // Distance from p to the outside of the box, so that far points start searching at
-        // the right ring.
         double best2 = 1e300;
         const int max_ring = std::max({n_[0], n_[1], n_[2]});
         for (int ring = 0; ring <= max_ring; ++ring) {

@@ -554,7 +554,6 @@ struct Builder {
     const Mesh& m;
     const FaceMap<std::int32_t>& region;
     std::span<const RegionSurface> surfaces;
-    const SurfaceBrepOptions& opt;
     RegionBorders borders;
     std::vector<RegionShape> shapes;
     std::vector<std::size_t> facets;  ///< per region
@@ -564,9 +563,8 @@ struct Builder {
     // Per region: loops of (chain, runs along it).
     std::vector<std::vector<std::vector<std::pair<std::int32_t, bool>>>> loops;
 
-    Builder(const Mesh& mesh, const FaceMap<std::int32_t>& r, std::span<const RegionSurface> s,
-            const SurfaceBrepOptions& o)
-        : m(mesh), region(r), surfaces(s), opt(o) {}
+    Builder(const Mesh& mesh, const FaceMap<std::int32_t>& r, std::span<const RegionSurface> s)
+        : m(mesh), region(r), surfaces(s) {}
 
     void prepare() {
         borders = region_borders(m, region);
@@ -658,7 +656,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     out.regions.assign(nr, {});
     // The labels, changed where a failing region is absorbed by a neighbour.
     FaceMap<std::int32_t> labels = region;
-    Builder bd(m, labels, regions, opt);
+    Builder bd(m, labels, regions);
     bd.prepare();
     const RegionBorders& borders = bd.borders;
     const double max_tol = std::max(opt.chordal_deflection, 10 * opt.tolerance);
@@ -1059,9 +1057,6 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             }
         }
         // Facet faces of the fallback regions.
-        for (std::size_t r = 0; r < nr; ++r) {
-            if (!fallback[r]) continue;
-        }
         for (std::uint32_t fi = 0; fi < m.num_faces(); ++fi) {
             const FaceId f(fi);
             const auto r = static_cast<std::size_t>(labels[f]);

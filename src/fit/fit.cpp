@@ -1176,6 +1176,23 @@ FitResult fit_swept_torus(const FitInput& in) {
 
 double distance(const Surface& s, Vec3 p) { return norm(p - closest_point(s, p)); }
 
+namespace {
+
+// The foot of p on a sheared kind's elliptic cylinder (the shear cylinder itself, the swept
+// torus's spine): the point, and the (unnormalised) normal of its ellipse there.
+struct EllipticFoot {
+    Vec3 on, normal, w;
+};
+EllipticFoot elliptic_foot(const Surface& s, Vec3 p) {
+    const EllipticCylinder e = elliptic_of(s.point, s.axis, s.radius, s.sweep);
+    double x, y, ex, ey, nx, ny, h;
+    e.signed_distance(p, x, y, ex, ey, nx, ny, h);
+    const Vec3 m = cross(e.d, e.w);
+    return {e.c + h * e.d + ex * e.w + ey * m, nx * e.w + ny * m, e.w};
+}
+
+}  // namespace
+
 Vec3 closest_point(const Surface& s, Vec3 p) {
     const Vec3 q = p - s.point;
     switch (s.kind) {
@@ -1217,15 +1234,11 @@ Vec3 closest_point(const Surface& s, Vec3 p) {
         }
         case FitKind::kShearCylinder:
         case FitKind::kSweptTorus: {
-            const EllipticCylinder e = elliptic_of(s.point, s.axis, s.radius, s.sweep);
-            double x, y, ex, ey, nx, ny, h;
-            e.signed_distance(p, x, y, ex, ey, nx, ny, h);
-            const Vec3 m = cross(e.d, e.w);
-            const Vec3 on = e.c + h * e.d + ex * e.w + ey * m;
-            if (s.kind == FitKind::kShearCylinder) return on;
-            const Vec3 out = p - on;
+            const EllipticFoot f = elliptic_foot(s, p);
+            if (s.kind == FitKind::kShearCylinder) return f.on;
+            const Vec3 out = p - f.on;
             const double lo = norm(out);
-            return on + s.minor_radius * (lo > 0 ? out / lo : nx * e.w + ny * m);
+            return f.on + s.minor_radius * (lo > 0 ? out / lo : f.normal);
         }
         case FitKind::kBSpline: {
             if (!s.bspline) return p;
@@ -1239,7 +1252,6 @@ Vec3 closest_point(const Surface& s, Vec3 p) {
 }
 
 Vec3 normal_at(const Surface& s, Vec3 p) {
-    const Vec3 q = closest_point(s, p);
     const auto unit_or = [](Vec3 v, Vec3 fallback) {
         const double l = norm(v);
         return l > 0 ? v / l : fallback;
@@ -1248,10 +1260,11 @@ Vec3 normal_at(const Surface& s, Vec3 p) {
         case FitKind::kPlane:
             return s.axis;
         case FitKind::kSphere:
-            return unit_or(q - s.point, s.axis);
+            return unit_or(closest_point(s, p) - s.point, s.axis);
         case FitKind::kCylinder:
         case FitKind::kCone:
         case FitKind::kTorus: {
+            const Vec3 q = closest_point(s, p);
             const Vec3 w = q - s.point;
             Vec3 e = w - dot(w, s.axis) * s.axis;
             const double rho = norm(e);
@@ -1267,14 +1280,12 @@ Vec3 normal_at(const Surface& s, Vec3 p) {
         }
         case FitKind::kShearCylinder:
         case FitKind::kSweptTorus: {
-            const EllipticCylinder e = elliptic_of(s.point, s.axis, s.radius, s.sweep);
-            double x, y, ex, ey, nx, ny, h;
-            e.signed_distance(p, x, y, ex, ey, nx, ny, h);
-            const Vec3 m = cross(e.d, e.w);
-            const Vec3 ellipse_normal = unit_or(nx * e.w + ny * m, e.w);
+            // The swept torus's closest point lies on the line from the elliptic cylinder's
+            // foot to p, so that line is its normal.
+            const EllipticFoot f = elliptic_foot(s, p);
+            const Vec3 ellipse_normal = unit_or(f.normal, f.w);
             if (s.kind == FitKind::kShearCylinder) return ellipse_normal;
-            const Vec3 on = e.c + h * e.d + ex * e.w + ey * m;
-            return unit_or(q - on, ellipse_normal);
+            return unit_or(p - f.on, ellipse_normal);
         }
         case FitKind::kBSpline: {
             if (!s.bspline) return s.axis;
