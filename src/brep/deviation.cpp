@@ -19,11 +19,7 @@
 
 namespace ncrev::brep_detail {
 
-namespace {
-
-using Triangle = std::array<Vec3, 3>;
-
-// Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+// Ericson, Real-Time Collision Detection, 5.1.5.
 Vec3 closest_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
     const Vec3 ab = b - a, ac = c - a, ap = p - a;
     const double d1 = dot(ab, ap), d2 = dot(ac, ap);
@@ -45,6 +41,10 @@ Vec3 closest_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
     const double denom = 1.0 / (va + vb + vc);
     return a + (vb * denom) * ab + (vc * denom) * ac;
 }
+
+namespace {
+
+using Triangle = std::array<Vec3, 3>;
 
 class TriangleGrid {
    public:

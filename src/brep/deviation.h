@@ -15,4 +15,7 @@ namespace ncrev::brep_detail {
 /// Deterministic whatever the thread count.
 SolidDeviation measure_deviation(const TopoDS_Shape& shape, const Mesh& mesh, double deflection);
 
+/// The point of triangle abc closest to p.
+Vec3 closest_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c);
+
 }  // namespace ncrev::brep_detail

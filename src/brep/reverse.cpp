@@ -58,6 +58,9 @@ namespace {  // Largest B-rep on which OpenCASCADE's BRepCheck_Analyzer also run
 // about 1.5 s here); larger ones rely on the structural check, which the construction
 // guarantees anyway and which costs O(n).
 constexpr std::uint64_t kOcctCheckMaxFaces = 5000;
+// Rebuilds after the written STEP read back wrong, each with the regions found there as facets
+// (one usually suffices; each costs the B-rep and STEP stages again).
+constexpr int kReadBackRetries = 3;
 
 }  // namespace
 
@@ -177,6 +180,44 @@ std::vector<std::int64_t> region_colors(const Mesh& mesh, const SegmentResult& s
     return out;
 }
 
+// Marks in `facets_only` the surface regions (not yet fallback) with a facet within `radius`
+// of one of `places`: the curved ones, or the planes where no curved one is there (planes
+// rarely fail; the curved faces beside them do). Returns how many it marked.
+std::size_t regions_near(const Mesh& mesh, const FaceMap<std::int32_t>& labels,
+                         const brep_detail::SurfaceBrep& brep,
+                         std::span<const brep_detail::RegionSurface> surfaces,
+                         const std::vector<std::array<double, 3>>& places, double radius,
+                         std::vector<std::uint8_t>& facets_only) {
+    std::size_t marked = 0;
+    for (const auto& pl : places) {
+        const Vec3 p{pl[0], pl[1], pl[2]};
+        std::vector<std::size_t> curved, flat;
+        for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
+            const FaceId id(f);
+            const Vec3 q = brep_detail::closest_on_triangle(p, mesh.position(mesh.vertex(id, 0)),
+                                                            mesh.position(mesh.vertex(id, 1)),
+                                                            mesh.position(mesh.vertex(id, 2)));
+            if (norm(q - p) > radius) continue;
+            auto r = static_cast<std::size_t>(labels[id]);
+            // A sliver absorbed by a neighbour is that neighbour's face now.
+            while (brep.regions[r].absorbed_into >= 0) {
+                r = static_cast<std::size_t>(brep.regions[r].absorbed_into);
+            }
+            if (brep.regions[r].fallback || facets_only[r]) continue;
+            const bool plane =
+                surfaces[r].has_surface && surfaces[r].surface.kind == FitKind::kPlane;
+            (plane ? flat : curved).push_back(r);
+        }
+        for (std::size_t r : curved.empty() ? flat : curved) {
+            if (!facets_only[r]) {
+                facets_only[r] = 1;
+                ++marked;
+            }
+        }
+    }
+    return marked;
+}
+
 Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                                        const std::filesystem::path& output,
                                        const ReverseOptions& options, ReverseReport rep) {
@@ -283,145 +324,168 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     bo.tolerance = sr.tolerance;
     bo.chordal_deflection = std::max(sr.chordal_deflection, sr.tolerance);
     bo.allow_fallback = options.method == ReverseMethod::kAuto;
-    brep_detail::SurfaceBrep brep;
-    stage("brep", [&] { brep = brep_detail::build_surface_brep(mesh, labels, surfaces, bo); });
-    rep.corners = brep.corners;
-    rep.max_corner_residual = brep.max_corner_residual;
-    rep.max_tolerance = brep.max_tolerance;
-    rep.edges_by_curve = {{"intersection", brep.intersection_edges},
-                          {"analytic", brep.analytic_edges},
-                          {"fitted", brep.fitted_edges},
-                          {"polyline", brep.polyline_edges}};
-    for (std::size_t r = 0; r < brep.regions.size(); ++r) {
-        const brep_detail::RegionBuild& b = brep.regions[r];
-        const Region& g = sr.regions[origin[r]];
-        if (b.absorbed_into >= 0) {
-            ++rep.absorbed_regions;
-        } else if (b.fallback) {
-            ReverseFallback fb;
-            fb.region = static_cast<std::int32_t>(origin[r]);
-            fb.facets = b.faces.size();
-            fb.kind = g.fit.ok ? to_string(g.fit.surface.kind) : "none";
-            fb.reason = b.reason;
-            rep.fallback_faces += b.faces.size();
-            rep.fallbacks.push_back(std::move(fb));
-            rep.faces_by_kind["facet"] += b.faces.size();
-        } else if (!b.faces.empty()) {
-            rep.faces_by_kind[to_string(g.fit.surface.kind)] += b.faces.size();
+    // Faces that pass in memory can fail once written and read back (STEP keeps no tolerances
+    // and the reader heals): their regions are found near where the read-back shape is
+    // wrong, built from their facets, and the part is built and written again, up to
+    // kReadBackRetries times before the whole part goes planar.
+    bo.facets_only.assign(surfaces.size(), 0);
+    bo.facets_only_reason = "its face fails once the STEP is read back";
+    const ReverseReport before_brep = rep;
+    for (int attempt = 0;; ++attempt) {
+        if (attempt > 0) {
+            auto stages = std::move(rep.stage_seconds);
+            rep = before_brep;
+            rep.stage_seconds = std::move(stages);
         }
-    }
-    rep.solid = brep.solid;
-    rep.valid = brep.valid && brep.solid;
-    rep.occt_checked = !brep.shape.IsNull();
-    if (!brep.shape.IsNull()) {
-        TopTools_IndexedMapOfShape faces, edges, vertices;
-        TopExp::MapShapes(brep.shape, TopAbs_FACE, faces);
-        TopExp::MapShapes(brep.shape, TopAbs_EDGE, edges);
-        TopExp::MapShapes(brep.shape, TopAbs_VERTEX, vertices);
-        rep.faces = static_cast<std::uint64_t>(faces.Extent());
-        rep.edges = static_cast<std::uint64_t>(edges.Extent());
-        rep.vertices = static_cast<std::uint64_t>(vertices.Extent());
-        stage("measure", [&] {
-            GProp_GProps vp, sp;
-            BRepGProp::SurfaceProperties(brep.shape, sp);
-            rep.solid_area = sp.Mass();
-            if (brep.solid) {
-                BRepGProp::VolumeProperties(brep.shape, vp);
-                rep.solid_volume = vp.Mass();
-                if (rep.mesh_volume != 0) {
-                    rep.volume_difference = (rep.solid_volume - rep.mesh_volume) / rep.mesh_volume;
+        brep_detail::SurfaceBrep brep;
+        stage("brep", [&] { brep = brep_detail::build_surface_brep(mesh, labels, surfaces, bo); });
+        rep.corners = brep.corners;
+        rep.max_corner_residual = brep.max_corner_residual;
+        rep.max_tolerance = brep.max_tolerance;
+        rep.edges_by_curve = {{"intersection", brep.intersection_edges},
+                              {"analytic", brep.analytic_edges},
+                              {"fitted", brep.fitted_edges},
+                              {"polyline", brep.polyline_edges}};
+        for (std::size_t r = 0; r < brep.regions.size(); ++r) {
+            const brep_detail::RegionBuild& b = brep.regions[r];
+            const Region& g = sr.regions[origin[r]];
+            if (b.absorbed_into >= 0) {
+                ++rep.absorbed_regions;
+            } else if (b.fallback) {
+                ReverseFallback fb;
+                fb.region = static_cast<std::int32_t>(origin[r]);
+                fb.facets = b.faces.size();
+                fb.kind = g.fit.ok ? to_string(g.fit.surface.kind) : "none";
+                fb.reason = b.reason;
+                rep.fallback_faces += b.faces.size();
+                rep.fallbacks.push_back(std::move(fb));
+                rep.faces_by_kind["facet"] += b.faces.size();
+            } else if (!b.faces.empty()) {
+                rep.faces_by_kind[to_string(g.fit.surface.kind)] += b.faces.size();
+            }
+        }
+        rep.solid = brep.solid;
+        rep.valid = brep.valid && brep.solid;
+        rep.occt_checked = !brep.shape.IsNull();
+        if (!brep.shape.IsNull()) {
+            TopTools_IndexedMapOfShape faces, edges, vertices;
+            TopExp::MapShapes(brep.shape, TopAbs_FACE, faces);
+            TopExp::MapShapes(brep.shape, TopAbs_EDGE, edges);
+            TopExp::MapShapes(brep.shape, TopAbs_VERTEX, vertices);
+            rep.faces = static_cast<std::uint64_t>(faces.Extent());
+            rep.edges = static_cast<std::uint64_t>(edges.Extent());
+            rep.vertices = static_cast<std::uint64_t>(vertices.Extent());
+            stage("measure", [&] {
+                GProp_GProps vp, sp;
+                BRepGProp::SurfaceProperties(brep.shape, sp);
+                rep.solid_area = sp.Mass();
+                if (brep.solid) {
+                    BRepGProp::VolumeProperties(brep.shape, vp);
+                    rep.solid_volume = vp.Mass();
+                    if (rep.mesh_volume != 0) {
+                        rep.volume_difference =
+                            (rep.solid_volume - rep.mesh_volume) / rep.mesh_volume;
+                    }
+                }
+                if (options.measure_deviation && rep.valid) {
+                    rep.deviation = brep_detail::measure_deviation(
+                        brep.shape, mesh, 0.5 * std::max(sr.chordal_deflection, sr.tolerance));
+                }
+            });
+        }
+        for (const ReverseFallback& fb : rep.fallbacks) {
+            rep.warnings.push_back("region " + std::to_string(fb.region) + " (" + fb.kind + ", " +
+                                   std::to_string(fb.facets) +
+                                   " facets) built from its facets: " + fb.reason);
+        }
+        rep.segmentation = sr;
+        // The last resort, so that a closed mesh always gives a valid closed solid: the whole part
+        // as planar faces (that construction cannot fail), reported as one fallback.
+        const auto whole_planar = [&](ReverseReport base,
+                                      const std::string& why) -> Result<ReverseReport> {
+            ReverseReport planar = std::move(base);
+            planar.faces_by_kind.clear();
+            planar.deviation.reset();
+            planar.volume_difference = 0;
+            planar.warnings.push_back(why);
+            ReverseFallback all;
+            all.region = -1;
+            all.facets = mesh.num_faces();
+            all.kind = "all";
+            all.reason = why;
+            planar.fallbacks.push_back(all);
+            planar.written = false;
+            planar.step_bytes = 0;
+            auto out = reverse_planar(mesh, stats, output, options, std::move(planar));
+            if (out && out->solid && out->mesh_volume != 0) {
+                out->volume_difference = (out->solid_volume - out->mesh_volume) / out->mesh_volume;
+            }
+            return out;
+        };
+        if (!rep.valid && options.method == ReverseMethod::kAuto) {
+            return whole_planar(rep,
+                                "the B-rep from the surfaces is invalid (" +
+                                    (brep.problem.empty() ? std::string("unknown") : brep.problem) +
+                                    "): the whole part is built with the planar method");
+        }
+        if (!rep.valid) {
+            rep.warnings.push_back("the B-rep is invalid (" +
+                                   (brep.problem.empty() ? std::string("unknown") : brep.problem) +
+                                   "): nothing written");
+            return rep;
+        }
+        Status written = Ok{};
+        stage("step", [&] {
+            brep_detail::StepWriteOptions w = step_write_options(options);
+            if (options.colors) {
+                w.shape_color = kind_color("facet");
+                const std::vector<std::int64_t> tool = region_colors(mesh, *rep.segmentation);
+                for (std::size_t r = 0; r < brep.regions.size(); ++r) {
+                    const brep_detail::RegionBuild& b = brep.regions[r];
+                    const std::int64_t t = tool[origin[r]];
+                    const std::uint32_t rgb =
+                        t >= 0 ? static_cast<std::uint32_t>(t & 0xFFFFFF)
+                               : kind_color(to_string(
+                                     rep.segmentation->regions[origin[r]].fit.surface.kind));
+                    // Fallback facets take the shape's color (set above): thousands of colored
+                    // sub-shapes would cost more than the rest of the STEP.
+                    if (b.fallback && t < 0) continue;
+                    for (const TopoDS_Face& f : b.faces) w.face_colors.emplace_back(f, rgb);
                 }
             }
-            if (options.measure_deviation && rep.valid) {
-                rep.deviation = brep_detail::measure_deviation(
-                    brep.shape, mesh, 0.5 * std::max(sr.chordal_deflection, sr.tolerance));
-            }
+            written = brep_detail::write_step_file(brep.shape, output, w);
         });
-    }
-    for (const ReverseFallback& fb : rep.fallbacks) {
-        rep.warnings.push_back("region " + std::to_string(fb.region) + " (" + fb.kind + ", " +
-                               std::to_string(fb.facets) +
-                               " facets) built from its facets: " + fb.reason);
-    }
-    rep.segmentation = std::move(*seg);
-    // The last resort, so that a closed mesh always gives a valid closed solid: the whole part
-    // as planar faces (that construction cannot fail), reported as one fallback.
-    const auto whole_planar = [&](ReverseReport base,
-                                  const std::string& why) -> Result<ReverseReport> {
-        ReverseReport planar = std::move(base);
-        planar.faces_by_kind.clear();
-        planar.deviation.reset();
-        planar.volume_difference = 0;
-        planar.warnings.push_back(why);
-        ReverseFallback all;
-        all.region = -1;
-        all.facets = mesh.num_faces();
-        all.kind = "all";
-        all.reason = why;
-        planar.fallbacks.push_back(all);
-        planar.written = false;
-        planar.step_bytes = 0;
-        auto out = reverse_planar(mesh, stats, output, options, std::move(planar));
-        if (out && out->solid && out->mesh_volume != 0) {
-            out->volume_difference = (out->solid_volume - out->mesh_volume) / out->mesh_volume;
+        if (!written) return written.error();
+        // What a CAD system will see: the file read back (STEP keeps no tolerances; the reader
+        // derives them) must pass the check too — up to kOcctCheckMaxFaces faces (reading and
+        // checking cost ~1 ms a face; larger B-reps are all but fallback facets).
+        brep_detail::ReadBack back;
+        if (rep.faces <= kOcctCheckMaxFaces) {
+            stage("verify", [&] { back = brep_detail::step_read_back(output); });
         }
-        return out;
-    };
-    if (!rep.valid && options.method == ReverseMethod::kAuto) {
-        return whole_planar(rep,
-                            "the B-rep from the surfaces is invalid (" +
-                                (brep.problem.empty() ? std::string("unknown") : brep.problem) +
-                                "): the whole part is built with the planar method");
-    }
-    if (!rep.valid) {
-        rep.warnings.push_back("the B-rep is invalid (" +
-                               (brep.problem.empty() ? std::string("unknown") : brep.problem) +
-                               "): nothing written");
-        return rep;
-    }
-    Status written = Ok{};
-    stage("step", [&] {
-        brep_detail::StepWriteOptions w = step_write_options(options);
-        if (options.colors) {
-            w.shape_color = kind_color("facet");
-            const std::vector<std::int64_t> tool = region_colors(mesh, *rep.segmentation);
-            for (std::size_t r = 0; r < brep.regions.size(); ++r) {
-                const brep_detail::RegionBuild& b = brep.regions[r];
-                const std::int64_t t = tool[origin[r]];
-                const std::uint32_t rgb =
-                    t >= 0 ? static_cast<std::uint32_t>(t & 0xFFFFFF)
-                           : kind_color(
-                                 to_string(rep.segmentation->regions[origin[r]].fit.surface.kind));
-                // Fallback facets take the shape's color (set above): thousands of colored
-                // sub-shapes would cost more than the rest of the STEP.
-                if (b.fallback && t < 0) continue;
-                for (const TopoDS_Face& f : b.faces) w.face_colors.emplace_back(f, rgb);
+        const std::string& back_problem = back.problem;
+        if (!back_problem.empty() && options.method == ReverseMethod::kAuto &&
+            attempt < kReadBackRetries) {
+            const std::size_t found = regions_near(
+                mesh, labels, brep, surfaces, back.places,
+                2 * std::max(bo.chordal_deflection, brep.max_tolerance), bo.facets_only);
+            if (found > 0) continue;
+        }
+        if (!back_problem.empty()) {
+            if (options.method == ReverseMethod::kAuto) {
+                return whole_planar(rep, "the STEP of the surfaces reads back invalid (" +
+                                             back_problem +
+                                             "): the whole part is built with the planar method");
             }
+            std::error_code ec;
+            std::filesystem::remove(output, ec);
+            rep.valid = false;
+            rep.warnings.push_back("the STEP reads back invalid (" + back_problem +
+                                   "): nothing written");
+            return rep;
         }
-        written = brep_detail::write_step_file(brep.shape, output, w);
-    });
-    if (!written) return written.error();
-    // What a CAD system will see: the file read back (STEP keeps no tolerances; the reader
-    // derives them) must pass the check too — up to kOcctCheckMaxFaces faces (reading and
-    // checking cost ~1 ms a face; larger B-reps are all but fallback facets).
-    std::string back_problem;
-    if (rep.faces <= kOcctCheckMaxFaces) {
-        stage("verify", [&] { back_problem = brep_detail::step_reads_back_invalid(output); });
+        return mark_written(std::move(rep), output);
     }
-    if (!back_problem.empty()) {
-        if (options.method == ReverseMethod::kAuto) {
-            return whole_planar(rep, "the STEP of the surfaces reads back invalid (" +
-                                         back_problem +
-                                         "): the whole part is built with the planar method");
-        }
-        std::error_code ec;
-        std::filesystem::remove(output, ec);
-        rep.valid = false;
-        rep.warnings.push_back("the STEP reads back invalid (" + back_problem +
-                               "): nothing written");
-        return rep;
-    }
-    return mark_written(std::move(rep), output);
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 
 #include <APIHeaderSection_MakeHeader.hxx>
 #include <BRepCheck_Analyzer.hxx>
+#include <BRep_Tool.hxx>
+#include <Geom_Curve.hxx>
 #include <Interface_Static.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
@@ -20,7 +22,13 @@
 #include <TDF_Label.hxx>
 #include <TDocStd_Document.hxx>
 #include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedDataMapOfShapeListOfShape.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Vertex.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
@@ -167,21 +175,50 @@ Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& p
     return Ok{};
 }
 
-std::string step_reads_back_invalid(const std::filesystem::path& path) {
+ReadBack step_read_back(const std::filesystem::path& path) {
     silence_occt();
+    ReadBack out;
+    const auto place = [&](const gp_Pnt& p) {
+        if (out.places.size() < kReadBackPlaces) out.places.push_back({p.X(), p.Y(), p.Z()});
+    };
     try {
         STEPControl_Reader reader;
-        if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) return "OpenCASCADE cannot read it";
+        if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) {
+            out.problem = "OpenCASCADE cannot read it";
+            return out;
+        }
         reader.TransferRoots();
         const TopoDS_Shape shape = reader.OneShape();
         TopTools_IndexedMapOfShape solids;
         TopExp::MapShapes(shape, TopAbs_SOLID, solids);
-        if (solids.Extent() != 1) return std::to_string(solids.Extent()) + " solids";
-        if (!BRepCheck_Analyzer(shape).IsValid()) return "BRepCheck_Analyzer finds defects";
+        if (solids.Extent() != 1) out.problem = std::to_string(solids.Extent()) + " solids";
+        // Edges of one face only (not seams): where the reader's healing opened the shell.
+        TopTools_IndexedDataMapOfShapeListOfShape edge_faces;
+        TopExp::MapShapesAndUniqueAncestors(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces);
+        for (int i = 1; i <= edge_faces.Extent(); ++i) {
+            const TopoDS_Edge& e = TopoDS::Edge(edge_faces.FindKey(i));
+            const TopTools_ListOfShape& fs = edge_faces.FindFromIndex(i);
+            if (BRep_Tool::Degenerated(e) || fs.Extent() != 1 ||
+                BRep_Tool::IsClosed(e, TopoDS::Face(fs.First()))) {
+                continue;
+            }
+            double a = 0, b = 0;
+            const Handle(Geom_Curve) c = BRep_Tool::Curve(e, a, b);
+            place(c.IsNull() ? BRep_Tool::Pnt(TopExp::FirstVertex(e)) : c->Value(0.5 * (a + b)));
+        }
+        const BRepCheck_Analyzer check(shape);
+        if (!check.IsValid()) {
+            if (out.problem.empty()) out.problem = "BRepCheck_Analyzer finds defects";
+            for (TopExp_Explorer x(shape, TopAbs_FACE); x.More(); x.Next()) {
+                if (BRepCheck_Analyzer(x.Current()).IsValid()) continue;
+                TopExp_Explorer v(x.Current(), TopAbs_VERTEX);
+                if (v.More()) place(BRep_Tool::Pnt(TopoDS::Vertex(v.Current())));
+            }
+        }
     } catch (const Standard_Failure& f) {
-        return std::string("OpenCASCADE fails reading it: ") + f.GetMessageString();
+        out.problem = std::string("OpenCASCADE fails reading it: ") + f.GetMessageString();
     }
-    return {};
+    return out;
 }
 
 }  // namespace ncrev::brep_detail

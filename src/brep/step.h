@@ -4,6 +4,7 @@
 
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -39,8 +40,17 @@ struct StepWriteOptions {
 Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& path,
                        const StepWriteOptions& options);
 
-/// Reads `path` back with OpenCASCADE's STEP reader and checks it: empty when it holds one
-/// solid that passes BRepCheck_Analyzer, else what is wrong.
-std::string step_reads_back_invalid(const std::filesystem::path& path);
+/// What the STEP reader makes of a written file.
+struct ReadBack {
+    std::string problem;  ///< empty when it holds one solid that passes BRepCheck_Analyzer
+    /// Where it is wrong, as far as the read-back shape tells: the middles of edges that bound
+    /// only one face, and a vertex of each face BRepCheck_Analyzer finds wrong (at most
+    /// kReadBackPlaces of them).
+    std::vector<std::array<double, 3>> places;
+};
+inline constexpr std::size_t kReadBackPlaces = 64;
+
+/// Reads `path` back with OpenCASCADE's STEP reader and checks it.
+ReadBack step_read_back(const std::filesystem::path& path);
 
 }  // namespace ncrev::brep_detail

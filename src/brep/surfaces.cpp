@@ -124,7 +124,37 @@ struct RegionShape {
     Vec3 normal;
     double area = 0;
     std::vector<FaceId> samples;  ///< facets spread over the region
+    std::vector<Vec3> vertices;   ///< of its facets (each once per facet)
+    std::vector<Vec3> border;     ///< its border vertices
 };
+
+// The direction, perpendicular to `axis`, in the middle of the widest angular gap between
+// `points` about the axis through `origin`: a periodic surface's seam put there lies outside
+// the region when the region does not go round, and between its vertices when it does (a seam
+// through a border vertex, or along a border edge in a symmetry plane, makes the face's wire
+// touch itself on the seam). `fallback` when no point is off the axis.
+Vec3 seam_direction(Vec3 origin, Vec3 axis, const std::vector<Vec3>& points, Vec3 fallback) {
+    const Vec3 x = normalized(any_perpendicular(axis));
+    const Vec3 y = cross(axis, x);
+    std::vector<double> angle;
+    angle.reserve(points.size());
+    for (const Vec3& p : points) {
+        const Vec3 d = p - origin;
+        const double dx = dot(d, x), dy = dot(d, y);
+        if (dx * dx + dy * dy > 0) angle.push_back(std::atan2(dy, dx));
+    }
+    if (angle.empty()) return fallback;
+    std::sort(angle.begin(), angle.end());
+    double best_gap = angle.front() + 2 * std::numbers::pi - angle.back(), best = angle.back();
+    for (std::size_t i = 1; i < angle.size(); ++i) {
+        if (angle[i] - angle[i - 1] > best_gap) {
+            best_gap = angle[i] - angle[i - 1];
+            best = angle[i - 1];
+        }
+    }
+    const double mid = best + 0.5 * best_gap;
+    return std::cos(mid) * x + std::sin(mid) * y;
+}
 
 // The OpenCASCADE surface of `s`, its seam (or pole) put away from the region: the seam of a
 // cylinder, cone or torus opposite the region's centroid, a sphere's pole at the middle of the
@@ -137,20 +167,28 @@ Handle(Geom_Surface) geom_surface(const Surface& s, const RegionShape& r, std::s
             return new Geom_Plane(frame(s.point, n, any_perpendicular(n)));
         }
         case FitKind::kCylinder:
-            return new Geom_CylindricalSurface(frame(s.point, axis, s.point - r.centroid),
-                                               s.radius);
+            return new Geom_CylindricalSurface(
+                frame(s.point, axis,
+                      seam_direction(s.point, axis, r.vertices, s.point - r.centroid)),
+                s.radius);
         case FitKind::kCone:
-            return new Geom_ConicalSurface(frame(s.point, axis, s.point - r.centroid), s.angle,
-                                           s.radius);
+            return new Geom_ConicalSurface(
+                frame(s.point, axis,
+                      seam_direction(s.point, axis, r.vertices, s.point - r.centroid)),
+                s.angle, s.radius);
         case FitKind::kSphere: {
             Vec3 pole = r.centroid - s.point;
             pole = norm(pole) > 1e-9 * s.radius ? normalized(pole) : Vec3{0, 0, 1};
-            return new Geom_SphericalSurface(frame(s.point, pole, any_perpendicular(pole)),
-                                             s.radius);
+            return new Geom_SphericalSurface(
+                frame(s.point, pole,
+                      seam_direction(s.point, pole, r.border, any_perpendicular(pole))),
+                s.radius);
         }
         case FitKind::kTorus:
-            return new Geom_ToroidalSurface(frame(s.point, axis, s.point - r.centroid), s.radius,
-                                            s.minor_radius);
+            return new Geom_ToroidalSurface(
+                frame(s.point, axis,
+                      seam_direction(s.point, axis, r.vertices, s.point - r.centroid)),
+                s.radius, s.minor_radius);
         case FitKind::kShearCylinder:
         case FitKind::kSweptTorus: {
             const gp_Ax2 ax = frame(s.point, axis, any_perpendicular(axis)).Ax2();
@@ -395,6 +433,87 @@ std::vector<Handle(Geom_Curve)> analytic_intersection(const Handle(Geom_Surface)
     return out;
 }
 
+// The spine of a tube surface nearest `p` and the tube's radius: a cylinder's axis, a torus's
+// center circle, a sphere's center. False for other kinds (and on a torus's axis).
+bool spine_point(const Surface& s, Vec3 p, Vec3& c, double& radius) {
+    const Vec3 axis = normalized(s.axis);
+    switch (s.kind) {
+        case FitKind::kCylinder:
+            c = s.point + dot(p - s.point, axis) * axis;
+            radius = s.radius;
+            return true;
+        case FitKind::kTorus: {
+            const Vec3 radial = perpendicular_part(p - s.point, axis);
+            if (norm(radial) <= 1e-12 * s.radius) return false;
+            c = s.point + s.radius * normalized(radial);
+            radius = s.minor_radius;
+            return true;
+        }
+        case FitKind::kSphere:
+            c = s.point;
+            radius = s.radius;
+            return true;
+        default:
+            return false;
+    }
+}
+
+// Where two tangent surfaces touch along a chain: one of them a tube (the one of smaller radius
+// when both are), the foot on the other of the tube's spine point nearest each chain vertex.
+// False when neither is a tube, or a foot is not at the tube's radius from its spine within
+// `tolerance` (the surfaces do not touch there).
+bool tangency_points(const Surface& a, const Surface& b, const Mesh& m,
+                     const std::vector<VertexId>& chain, double tolerance,
+                     std::vector<gp_Pnt>& out) {
+    Vec3 c;
+    double ra = 0, rb = 0;
+    const Vec3 p0 = m.position(chain[chain.size() / 2]);
+    const bool ta = spine_point(a, p0, c, ra), tb = spine_point(b, p0, c, rb);
+    if (!ta && !tb) return false;
+    const bool a_tube = ta && (!tb || ra <= rb);
+    const Surface& tube = a_tube ? a : b;
+    const Surface& other = a_tube ? b : a;
+    out.clear();
+    for (VertexId v : chain) {
+        const Vec3 p = m.position(v);
+        double radius = 0;
+        if (!spine_point(tube, p, c, radius)) return false;
+        // Two tubes whose spines meet (a corner torus running into the edge fillet of the
+        // same radius): every point of their common section is a foot; the chain's vertex
+        // says which.
+        Vec3 c2;
+        double r2 = 0;
+        if (spine_point(other, c, c2, r2) && norm(c2 - c) <= tolerance) {
+            if (norm(p - c) <= 0) return false;
+            out.push_back(pnt(c + radius * normalized(p - c)));
+            continue;
+        }
+        const Vec3 q = closest_point(other, c);
+        if (std::abs(norm(q - c) - radius) > tolerance) return false;
+        out.push_back(pnt(q));
+    }
+    return true;
+}
+
+// Whether `c` leaves the polyline through `points` by more than `accept` between them: the
+// chain's points lie on a branch that bulges away between them (an ellipse arc between two
+// close corners of a steep plane on a cylinder), or only the ends were there to check.
+bool strays_from(const ChainCurve& c, const std::vector<gp_Pnt>& points, double accept) {
+    const int n = 4 * static_cast<int>(std::min(points.size(), kChainSamples)) + 8;
+    for (int k = 1; k < n; ++k) {
+        const gp_Pnt q = c.curve->Value(c.first + (c.last - c.first) * k / n);
+        double best = 1e300;
+        for (std::size_t i = 0; i + 1 < points.size() && best > accept; ++i) {
+            const gp_Vec ab(points[i], points[i + 1]), aq(points[i], q);
+            const double len2 = ab.SquareMagnitude();
+            const double t = len2 > 0 ? std::clamp(aq.Dot(ab) / len2, 0.0, 1.0) : 0.0;
+            best = std::min(best, q.Distance(points[i].Translated(t * ab)));
+        }
+        if (best > accept) return true;
+    }
+    return false;
+}
+
 // The intersection branch of `a` and `b` along `points`, within `accept` of all of them:
 // analytic for elementary pairs, else OpenCASCADE's general surface intersection.
 bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surface) & b,
@@ -405,7 +524,10 @@ bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surfac
         bool found = false;
         for (const Handle(Geom_Curve) & line : lines) {
             ChainCurve c;
-            if (!trim_along(line, samples, closed, c) || c.deviation > accept) continue;
+            if (!trim_along(line, samples, closed, c) || c.deviation > accept ||
+                strays_from(c, points, accept)) {
+                continue;
+            }
             if (!found || c.deviation < out.deviation) {
                 out = c;
                 found = true;
@@ -581,6 +703,7 @@ struct Builder {
             shapes[r].centroid = shapes[r].centroid + a * c;
             shapes[r].normal = shapes[r].normal + 0.5 * n2;
             shapes[r].area += a;
+            for (int i = 0; i < 3; ++i) shapes[r].vertices.push_back(m.position(m.vertex(id, i)));
             faces[r].push_back(id);
         }
         facets.resize(nr);
@@ -592,6 +715,14 @@ struct Builder {
             const std::size_t n = faces[r].size();
             const std::size_t k = std::min(n, kOrientationSamples);
             for (std::size_t i = 0; i < k; ++i) s.samples.push_back(faces[r][i * n / k]);
+        }
+        for (const BorderChain& ch : borders.chains) {
+            for (std::int32_t r : {ch.left, ch.right}) {
+                if (r < 0) continue;
+                for (VertexId v : ch.vertices) {
+                    shapes[static_cast<std::size_t>(r)].border.push_back(m.position(v));
+                }
+            }
         }
         he_chain.assign(m.num_halfedges(), -1);
         he_forward.assign(m.num_halfedges(), 0);
@@ -677,6 +808,10 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     const auto compute_geometry = [&] {
         for (std::size_t r = 0; r < nr; ++r) {
             if (absorbed[r] >= 0 || fallback[r]) continue;
+            if (r < opt.facets_only.size() && opt.facets_only[r]) {
+                fall_back(r, opt.facets_only_reason);
+                continue;
+            }
             if (!regions[r].has_surface) {
                 fall_back(r, regions[r].no_surface_reason.empty() ? "no surface fits the region"
                                                                   : regions[r].no_surface_reason);
@@ -866,6 +1001,22 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     const Vec3 p = vec(pts.back());
                     min_sin = std::min(min_sin, norm(cross(normal_at(sa, p), normal_at(sb, p))));
                 }
+                // A tangent junction with a fillet (a cylinder, torus or sphere: a tube about a
+                // spine): where they touch is exact, the foot on the other surface of the
+                // spine point nearest each chain point. Solving onto both surfaces instead is
+                // ill-conditioned there: any point of the band where they are within the
+                // tolerance of each other is a solution, and the curve wanders across it.
+                // Taken when the curve through those points is within the tolerance of both
+                // surfaces (two cylinders crossing at a shallow angle are not tangent along a
+                // curve, and the feet are not where they meet).
+                std::vector<gp_Pnt> touch;
+                if (min_sin <= std::sin(kTangentAngle) && pts.size() > 2 &&
+                    tangency_points(sa, sb, m, ch.vertices, max_tol, touch)) {
+                    touch.front() = pts.front();
+                    touch.back() = pts.back();
+                } else {
+                    touch.clear();
+                }
                 ChainCurve cc;
                 bool ok = false, intersected = false;
                 try {
@@ -893,7 +1044,14 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                         const int samples = 4 * static_cast<int>(dense.size());
                         ChainCurve best;
                         best.deviation = -1;
-                        for (int variant = 0; variant < 3; ++variant) {
+                        bool touching = false;
+                        if (!touch.empty() &&
+                            fitted_curve(touch, ch.closed, linear[ra] || linear[rb], best)) {
+                            best.deviation = curve_off_surfaces(best, sa, sb, samples);
+                            touching = best.deviation <= max_tol;
+                            if (!touching) best.deviation = -1;
+                        }
+                        for (int variant = 0; variant < 3 && !touching; ++variant) {
                             ChainCurve t;
                             if (!fitted_curve(variant == 0 ? pts : dense, ch.closed, variant == 2,
                                               t)) {
@@ -963,15 +1121,21 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             relabelled();
             continue;
         }
+        // Only the smaller of the two becomes facets: the chain is then its polyline of mesh
+        // edges, chords of the larger region's surface like every edge between a surface face
+        // and fallback facets (a 215-facet plane went to facets for a 30-facet fillet's sake).
         for (std::int32_t c : failed_chain) {
             const BorderChain& ch = borders.chains[static_cast<std::size_t>(c)];
-            for (std::int32_t r : {ch.left, ch.right}) {
-                if (r < 0 || fallback[static_cast<std::size_t>(r)]) continue;
-                fall_back(static_cast<std::size_t>(r),
-                          "no edge curve with region " +
-                              std::to_string(r == ch.left ? ch.right : ch.left));
-                changed = true;
-            }
+            if (ch.right < 0) continue;
+            const auto l = static_cast<std::size_t>(ch.left),
+                       r = static_cast<std::size_t>(ch.right);
+            if (fallback[l] || fallback[r]) continue;
+            const bool left_smaller =
+                bd.facets[l] < bd.facets[r] ||
+                (bd.facets[l] == bd.facets[r] && regions[r].surface.kind == FitKind::kPlane);
+            const std::size_t drop = left_smaller ? l : r;
+            fall_back(drop, "no edge curve with region " + std::to_string(left_smaller ? r : l));
+            changed = true;
         }
         if (changed) {
             if (!opt.allow_fallback) break;
@@ -1015,6 +1179,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                         W.Closed(true);
                         B.Add(F, W);
                     }
+                    // The edges earlier faces' fixes replaced, replaced here too: a shared
+                    // edge fixed twice from its original would otherwise become two edges.
+                    F = TopoDS::Face(context->Apply(F));
                     ShapeFix_Face fix(F);
                     fix.SetContext(context);
                     fix.SetPrecision(kMinTolerance);

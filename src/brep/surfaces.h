@@ -30,6 +30,10 @@ struct SurfaceBrepOptions {
     double chordal_deflection = 0;
     /// A region whose face cannot be built comes back as its facets (true), or the build fails.
     bool allow_fallback = true;
+    /// Per region (may be empty): built from its facets from the start, with
+    /// `facets_only_reason` (its face came back wrong from a STEP file written before).
+    std::vector<std::uint8_t> facets_only;
+    std::string facets_only_reason;
 };
 
 /// What happened to one region.
