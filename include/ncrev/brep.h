@@ -108,7 +108,9 @@ struct ReverseReport {
     /// Regions whose own face failed and whose facets joined a neighbour's face (slivers that
     /// lie on the neighbour's surface).
     std::uint64_t absorbed_regions = 0;
-    std::map<std::string, std::uint64_t> edges_by_curve;  ///< intersection, fitted, polyline
+    /// Edges by how their curve was made: intersection, analytic (of them), tangency (a fillet's
+    /// exact contact), fitted, polyline.
+    std::map<std::string, std::uint64_t> edges_by_curve;
     std::uint64_t corners = 0;
     double max_corner_residual = 0;  ///< largest distance of a solved corner from its surfaces
     double max_tolerance = 0;        ///< largest vertex or edge tolerance of the B-rep

@@ -344,6 +344,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         rep.max_tolerance = brep.max_tolerance;
         rep.edges_by_curve = {{"intersection", brep.intersection_edges},
                               {"analytic", brep.analytic_edges},
+                              {"tangency", brep.tangency_edges},
                               {"fitted", brep.fitted_edges},
                               {"polyline", brep.polyline_edges}};
         for (std::size_t r = 0; r < brep.regions.size(); ++r) {

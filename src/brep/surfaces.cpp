@@ -124,37 +124,7 @@ struct RegionShape {
     Vec3 normal;
     double area = 0;
     std::vector<FaceId> samples;  ///< facets spread over the region
-    std::vector<Vec3> vertices;   ///< of its facets (each once per facet)
-    std::vector<Vec3> border;     ///< its border vertices
 };
-
-// The direction, perpendicular to `axis`, in the middle of the widest angular gap between
-// `points` about the axis through `origin`: a periodic surface's seam put there lies outside
-// the region when the region does not go round, and between its vertices when it does (a seam
-// through a border vertex, or along a border edge in a symmetry plane, makes the face's wire
-// touch itself on the seam). `fallback` when no point is off the axis.
-Vec3 seam_direction(Vec3 origin, Vec3 axis, const std::vector<Vec3>& points, Vec3 fallback) {
-    const Vec3 x = normalized(any_perpendicular(axis));
-    const Vec3 y = cross(axis, x);
-    std::vector<double> angle;
-    angle.reserve(points.size());
-    for (const Vec3& p : points) {
-        const Vec3 d = p - origin;
-        const double dx = dot(d, x), dy = dot(d, y);
-        if (dx * dx + dy * dy > 0) angle.push_back(std::atan2(dy, dx));
-    }
-    if (angle.empty()) return fallback;
-    std::sort(angle.begin(), angle.end());
-    double best_gap = angle.front() + 2 * std::numbers::pi - angle.back(), best = angle.back();
-    for (std::size_t i = 1; i < angle.size(); ++i) {
-        if (angle[i] - angle[i - 1] > best_gap) {
-            best_gap = angle[i] - angle[i - 1];
-            best = angle[i - 1];
-        }
-    }
-    const double mid = best + 0.5 * best_gap;
-    return std::cos(mid) * x + std::sin(mid) * y;
-}
 
 // The OpenCASCADE surface of `s`, its seam (or pole) put away from the region: the seam of a
 // cylinder, cone or torus opposite the region's centroid, a sphere's pole at the middle of the
@@ -167,28 +137,20 @@ Handle(Geom_Surface) geom_surface(const Surface& s, const RegionShape& r, std::s
             return new Geom_Plane(frame(s.point, n, any_perpendicular(n)));
         }
         case FitKind::kCylinder:
-            return new Geom_CylindricalSurface(
-                frame(s.point, axis,
-                      seam_direction(s.point, axis, r.vertices, s.point - r.centroid)),
-                s.radius);
+            return new Geom_CylindricalSurface(frame(s.point, axis, s.point - r.centroid),
+                                               s.radius);
         case FitKind::kCone:
-            return new Geom_ConicalSurface(
-                frame(s.point, axis,
-                      seam_direction(s.point, axis, r.vertices, s.point - r.centroid)),
-                s.angle, s.radius);
+            return new Geom_ConicalSurface(frame(s.point, axis, s.point - r.centroid), s.angle,
+                                           s.radius);
         case FitKind::kSphere: {
             Vec3 pole = r.centroid - s.point;
             pole = norm(pole) > 1e-9 * s.radius ? normalized(pole) : Vec3{0, 0, 1};
-            return new Geom_SphericalSurface(
-                frame(s.point, pole,
-                      seam_direction(s.point, pole, r.border, any_perpendicular(pole))),
-                s.radius);
+            return new Geom_SphericalSurface(frame(s.point, pole, any_perpendicular(pole)),
+                                             s.radius);
         }
         case FitKind::kTorus:
-            return new Geom_ToroidalSurface(
-                frame(s.point, axis,
-                      seam_direction(s.point, axis, r.vertices, s.point - r.centroid)),
-                s.radius, s.minor_radius);
+            return new Geom_ToroidalSurface(frame(s.point, axis, s.point - r.centroid), s.radius,
+                                            s.minor_radius);
         case FitKind::kShearCylinder:
         case FitKind::kSweptTorus: {
             const gp_Ax2 ax = frame(s.point, axis, any_perpendicular(axis)).Ax2();
@@ -703,7 +665,6 @@ struct Builder {
             shapes[r].centroid = shapes[r].centroid + a * c;
             shapes[r].normal = shapes[r].normal + 0.5 * n2;
             shapes[r].area += a;
-            for (int i = 0; i < 3; ++i) shapes[r].vertices.push_back(m.position(m.vertex(id, i)));
             faces[r].push_back(id);
         }
         facets.resize(nr);
@@ -715,14 +676,6 @@ struct Builder {
             const std::size_t n = faces[r].size();
             const std::size_t k = std::min(n, kOrientationSamples);
             for (std::size_t i = 0; i < k; ++i) s.samples.push_back(faces[r][i * n / k]);
-        }
-        for (const BorderChain& ch : borders.chains) {
-            for (std::int32_t r : {ch.left, ch.right}) {
-                if (r < 0) continue;
-                for (VertexId v : ch.vertices) {
-                    shapes[static_cast<std::size_t>(r)].border.push_back(m.position(v));
-                }
-            }
         }
         he_chain.assign(m.num_halfedges(), -1);
         he_forward.assign(m.num_halfedges(), 0);
@@ -909,7 +862,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     BRep_Builder B;
     for (int round = 1; round <= kMaxRounds; ++round) {
         out.rounds = round;
-        out.intersection_edges = out.fitted_edges = out.polyline_edges = 0;
+        out.intersection_edges = out.tangency_edges = out.fitted_edges = out.polyline_edges = 0;
         out.analytic_edges = 0;
         out.corners = 0;
         out.max_corner_residual = 0;
@@ -1018,7 +971,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     touch.clear();
                 }
                 ChainCurve cc;
-                bool ok = false, intersected = false;
+                bool ok = false, intersected = false, touched = false;
                 try {
                     if (min_sin > std::sin(kTangentAngle)) {
                         bool analytic = false;
@@ -1070,6 +1023,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                             if (best.deviation < 0 || t.deviation < best.deviation) best = t;
                         }
                         ok = best.deviation >= 0 && best.deviation <= max_tol;
+                        touched = touching;
                         if (ok) cc = best;
                     }
                     if (ok) {
@@ -1085,7 +1039,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                             TopoDS_Edge e = me.Edge();
                             B.UpdateEdge(e, std::max(kMinTolerance, 1.01 * cc.deviation));
                             chain_edges[c].push_back(e);
-                            ++(intersected ? out.intersection_edges : out.fitted_edges);
+                            ++(intersected ? out.intersection_edges
+                               : touched   ? out.tangency_edges
+                                           : out.fitted_edges);
                         }
                     }
                 } catch (const Standard_Failure&) {

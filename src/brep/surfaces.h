@@ -53,9 +53,11 @@ struct SurfaceBrep {
     std::string problem;  ///< what is wrong when not valid
     std::vector<RegionBuild> regions;
     /// Edges by how their curve was made: "intersection" (OpenCASCADE's surface intersection,
-    /// analytic for elementary pairs), "fitted" (a curve through the chain's points solved onto
-    /// both surfaces: tangent junctions, failed intersections), "polyline" (beside a fallback).
-    std::uint64_t intersection_edges = 0, fitted_edges = 0, polyline_edges = 0;
+    /// analytic for elementary pairs), "tangency" (a tangent junction with a tube: a curve
+    /// through the exact contact points), "fitted" (a curve through the chain's points solved
+    /// onto both surfaces: other tangent junctions, failed intersections), "polyline" (beside a
+    /// fallback).
+    std::uint64_t intersection_edges = 0, tangency_edges = 0, fitted_edges = 0, polyline_edges = 0;
     /// Of the intersection edges, those whose curve is exact (IntAna: a line, circle or
     /// ellipse where two elementary surfaces meet).
     std::uint64_t analytic_edges = 0;
