@@ -154,7 +154,10 @@ void BM_ReverseSurfaces(benchmark::State& state) {
     state.counters["faces"] = static_cast<double>(last.faces);
     state.counters["true_faces"] = static_cast<double>(c.true_faces);
     state.counters["fallbacks"] = static_cast<double>(last.fallbacks.size());
-    for (const auto& [stage, seconds] : last.stage_seconds) state.counters[stage + "_s"] = seconds;
+    // Summed per stage: a STEP that read back wrong has the B-rep built and written again.
+    for (const auto& [stage, seconds] : last.stage_seconds) {
+        state.counters[stage + "_s"] = state.counters[stage + "_s"] + seconds;
+    }
     state.SetLabel(c.name + " " + to_string(options.method));
 }
 BENCHMARK(BM_ReverseSurfaces)
