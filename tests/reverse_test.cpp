@@ -295,13 +295,14 @@ TEST(ReverseSurfaces, RealPartsFaceForFace) {
 void print_row(const std::string& name, const char* input, const Outcome& o) {
     const ReverseReport& r = o.report;
     // In units of δ; "—" where none was measured (the whole part went planar).
-    const auto dev = [&](double d) {
+    std::string dev1 = "—", dev2 = "—";
+    if (r.deviation) {
         char buf[32];
-        std::snprintf(buf, sizeof buf, "%.3f", d / o.deflection);
-        return r.deviation ? std::string(buf) : std::string("—");
-    };
-    const std::string dev1 = dev(r.deviation ? r.deviation->mesh_to_solid.max : 0);
-    const std::string dev2 = dev(r.deviation ? r.deviation->solid_to_mesh.max : 0);
+        std::snprintf(buf, sizeof buf, "%.3f", r.deviation->mesh_to_solid.max / o.deflection);
+        dev1 = buf;
+        std::snprintf(buf, sizeof buf, "%.3f", r.deviation->solid_to_mesh.max / o.deflection);
+        dev2 = buf;
+    }
     std::string kinds;
     for (const auto& [k, n] : r.faces_by_kind) {
         kinds += (kinds.empty() ? "" : " ") + std::to_string(n) + " " + k;

@@ -330,6 +330,29 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     // kReadBackRetries times before the whole part goes planar.
     bo.facets_only.assign(surfaces.size(), 0);
     bo.facets_only_reason = "its face fails once the STEP is read back";
+    // The last resort, so that a closed mesh always gives a valid closed solid: the whole part
+    // as planar faces (that construction cannot fail), reported as one fallback.
+    const auto whole_planar = [&](ReverseReport base,
+                                  const std::string& why) -> Result<ReverseReport> {
+        ReverseReport planar = std::move(base);
+        planar.faces_by_kind.clear();
+        planar.deviation.reset();
+        planar.volume_difference = 0;
+        planar.warnings.push_back(why);
+        ReverseFallback all;
+        all.region = -1;
+        all.facets = mesh.num_faces();
+        all.kind = "all";
+        all.reason = why;
+        planar.fallbacks.push_back(all);
+        planar.written = false;
+        planar.step_bytes = 0;
+        auto out = reverse_planar(mesh, stats, output, options, std::move(planar));
+        if (out && out->solid && out->mesh_volume != 0) {
+            out->volume_difference = (out->solid_volume - out->mesh_volume) / out->mesh_volume;
+        }
+        return out;
+    };
     const ReverseReport before_brep = rep;
     for (int attempt = 0;; ++attempt) {
         if (attempt > 0) {
@@ -400,29 +423,6 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                                    " facets) built from its facets: " + fb.reason);
         }
         rep.segmentation = sr;
-        // The last resort, so that a closed mesh always gives a valid closed solid: the whole part
-        // as planar faces (that construction cannot fail), reported as one fallback.
-        const auto whole_planar = [&](ReverseReport base,
-                                      const std::string& why) -> Result<ReverseReport> {
-            ReverseReport planar = std::move(base);
-            planar.faces_by_kind.clear();
-            planar.deviation.reset();
-            planar.volume_difference = 0;
-            planar.warnings.push_back(why);
-            ReverseFallback all;
-            all.region = -1;
-            all.facets = mesh.num_faces();
-            all.kind = "all";
-            all.reason = why;
-            planar.fallbacks.push_back(all);
-            planar.written = false;
-            planar.step_bytes = 0;
-            auto out = reverse_planar(mesh, stats, output, options, std::move(planar));
-            if (out && out->solid && out->mesh_volume != 0) {
-                out->volume_difference = (out->solid_volume - out->mesh_volume) / out->mesh_volume;
-            }
-            return out;
-        };
         if (!rep.valid && options.method == ReverseMethod::kAuto) {
             return whole_planar(rep,
                                 "the B-rep from the surfaces is invalid (" +

@@ -1,5 +1,6 @@
 # The brep module: OpenCASCADE B-rep construction and STEP writing.
 list(APPEND NCREV_OCCT_SOURCES
+    ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/check.cpp
     ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/planar.cpp
     ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/reverse.cpp
     ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/step.cpp

@@ -3,7 +3,6 @@
 #include <unistd.h>
 
 #include <APIHeaderSection_MakeHeader.hxx>
-#include <BRepCheck_Analyzer.hxx>
 #include <BRep_Tool.hxx>
 #include <Geom_Curve.hxx>
 #include <Interface_Static.hxx>
@@ -35,6 +34,8 @@
 #include <XCAFDoc_ShapeTool.hxx>
 #include <atomic>
 #include <mutex>
+
+#include "brep/check.h"
 
 namespace ncrev::brep_detail {
 
@@ -206,12 +207,14 @@ ReadBack step_read_back(const std::filesystem::path& path) {
             const Handle(Geom_Curve) c = BRep_Tool::Curve(e, a, b);
             place(c.IsNull() ? BRep_Tool::Pnt(TopExp::FirstVertex(e)) : c->Value(0.5 * (a + b)));
         }
-        const BRepCheck_Analyzer check(shape);
-        if (!check.IsValid()) {
-            if (out.problem.empty()) out.problem = "BRepCheck_Analyzer finds defects";
-            for (TopExp_Explorer x(shape, TopAbs_FACE); x.More(); x.Next()) {
-                if (BRepCheck_Analyzer(x.Current()).IsValid()) continue;
-                TopExp_Explorer v(x.Current(), TopAbs_VERTEX);
+        // Where the checker finds the shape wrong: a vertex of each defective face (one
+        // analysis of the whole shape; its results say which faces are wrong).
+        std::vector<TopoDS_Shape> bad;
+        if (const std::string why = check_failure(shape, &bad); !why.empty()) {
+            if (out.problem.empty()) out.problem = "BRepCheck_Analyzer: " + why;
+            for (const TopoDS_Shape& b : bad) {
+                if (b.ShapeType() != TopAbs_FACE) continue;
+                TopExp_Explorer v(b, TopAbs_VERTEX);
                 if (v.More()) place(BRep_Tool::Pnt(TopoDS::Vertex(v.Current())));
             }
         }

@@ -21,9 +21,6 @@
 
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
-#include <BRepCheck.hxx>
-#include <BRepCheck_Analyzer.hxx>
-#include <BRepCheck_Result.hxx>
 #include <BRepLib.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
@@ -72,9 +69,9 @@
 #include <cstdint>
 #include <map>
 #include <numbers>
-#include <sstream>
 #include <unordered_map>
 
+#include "brep/check.h"
 #include "ncrev/segment.h"
 
 namespace ncrev::brep_detail {
@@ -590,50 +587,6 @@ double curve_off_surfaces(const ChainCurve& c, const Surface& a, const Surface& 
     return worst;
 }
 
-// What BRepCheck_Analyzer finds wrong with `shape`, in words (empty when valid), and the
-// sub-shapes it finds wrong (vertices, edges, wires, faces) in `bad`.
-std::string check_failure(const TopoDS_Shape& shape, std::vector<TopoDS_Shape>* bad = nullptr) {
-    BRepCheck_Analyzer check(shape);
-    if (check.IsValid()) return {};
-    std::string out;
-    for (TopAbs_ShapeEnum type :
-         {TopAbs_VERTEX, TopAbs_EDGE, TopAbs_WIRE, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID}) {
-        TopTools_IndexedMapOfShape subs;
-        TopExp::MapShapes(shape, type, subs);
-        const std::string kind = type == TopAbs_VERTEX  ? "vertex"
-                                 : type == TopAbs_EDGE  ? "edge"
-                                 : type == TopAbs_WIRE  ? "wire"
-                                 : type == TopAbs_FACE  ? "face"
-                                 : type == TopAbs_SHELL ? "shell"
-                                                        : "solid";
-        for (int i = 1; i <= subs.Extent(); ++i) {
-            const Handle(BRepCheck_Result) res = check.Result(subs(i));
-            if (res.IsNull()) continue;
-            std::vector<BRepCheck_Status> statuses(res->Status().begin(), res->Status().end());
-            for (res->InitContextIterator(); res->MoreShapeInContext(); res->NextShapeInContext()) {
-                for (BRepCheck_Status st : res->StatusOnShape()) statuses.push_back(st);
-            }
-            bool wrong = false;
-            for (BRepCheck_Status st : statuses) {
-                if (st == BRepCheck_NoError) continue;
-                wrong = true;
-                std::ostringstream os;
-                BRepCheck::Print(st, os);
-                std::string word = os.str();
-                while (!word.empty() && std::isspace(static_cast<unsigned char>(word.back()))) {
-                    word.pop_back();
-                }
-                const std::string entry = kind + ": " + word;
-                if (out.size() < 300 && out.find(entry) == std::string::npos) {
-                    out += (out.empty() ? "" : "; ") + entry;
-                }
-            }
-            if (wrong && bad) bad->push_back(subs(i));
-        }
-    }
-    return out.empty() ? "invalid" : out;
-}
-
 struct Builder {
     const Mesh& m;
     const FaceMap<std::int32_t>& region;
@@ -954,6 +907,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     const Vec3 p = vec(pts.back());
                     min_sin = std::min(min_sin, norm(cross(normal_at(sa, p), normal_at(sb, p))));
                 }
+                const bool tangent = min_sin <= std::sin(kTangentAngle);
                 // A tangent junction with a fillet (a cylinder, torus or sphere: a tube about a
                 // spine): where they touch is exact, the foot on the other surface of the
                 // spine point nearest each chain point. Solving onto both surfaces instead is
@@ -963,7 +917,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 // surfaces (two cylinders crossing at a shallow angle are not tangent along a
                 // curve, and the feet are not where they meet).
                 std::vector<gp_Pnt> touch;
-                if (min_sin <= std::sin(kTangentAngle) && pts.size() > 2 &&
+                if (tangent && pts.size() > 2 &&
                     tangency_points(sa, sb, m, ch.vertices, max_tol, touch)) {
                     touch.front() = pts.front();
                     touch.back() = pts.back();
@@ -973,7 +927,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 ChainCurve cc;
                 bool ok = false, intersected = false, touched = false;
                 try {
-                    if (min_sin > std::sin(kTangentAngle)) {
+                    if (!tangent) {
                         bool analytic = false;
                         ok = intersection_curve(geom[ra], geom[rb], pts, ch.closed,
                                                 opt.chordal_deflection + opt.tolerance, cc,
@@ -982,29 +936,28 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                         if (ok && analytic) ++out.analytic_edges;
                     }
                     if (!ok) {
-                        // A cubic through the points; where it swings off the surfaces (points
-                        // unevenly spaced, a kink where the chain leaves the junction), the
-                        // piecewise-linear curve through them. Its tolerance: how far it
-                        // strays from the two surfaces.
-                        // The closest to the surfaces of: the cubic through the chain's
-                        // points, the cubic through them densified, the linear one.
-                        // Densified only where the surfaces cross: along a tangent junction every
-                        // point of a band about the tangency line is on both to the tolerance,
-                        // and solved points would wander across it.
-                        const std::vector<gp_Pnt> dense = min_sin > std::sin(kTangentAngle)
-                                                              ? densified(pts, pair, opt.tolerance)
-                                                              : pts;
+                        // The curve through the exact contact points where there are some and
+                        // it stays within the tolerance of both surfaces; otherwise the
+                        // closest to the surfaces of: the cubic through the chain's points,
+                        // the cubic through them densified, the piecewise-linear one (where a
+                        // cubic swings off the surfaces: points unevenly spaced, a kink where
+                        // the chain leaves the junction). Densified only where the surfaces
+                        // cross: along a tangent junction every point of a band about the
+                        // tangency line is on both to the tolerance, and solved points would
+                        // wander across it. The curve's distance from the two surfaces is its
+                        // tolerance.
+                        const std::vector<gp_Pnt> dense =
+                            tangent ? pts : densified(pts, pair, opt.tolerance);
                         const int samples = 4 * static_cast<int>(dense.size());
                         ChainCurve best;
                         best.deviation = -1;
-                        bool touching = false;
                         if (!touch.empty() &&
                             fitted_curve(touch, ch.closed, linear[ra] || linear[rb], best)) {
                             best.deviation = curve_off_surfaces(best, sa, sb, samples);
-                            touching = best.deviation <= max_tol;
-                            if (!touching) best.deviation = -1;
+                            touched = best.deviation <= max_tol;
+                            if (!touched) best.deviation = -1;
                         }
-                        for (int variant = 0; variant < 3 && !touching; ++variant) {
+                        for (int variant = 0; variant < 3 && !touched; ++variant) {
                             ChainCurve t;
                             if (!fitted_curve(variant == 0 ? pts : dense, ch.closed, variant == 2,
                                               t)) {
@@ -1015,15 +968,14 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                             // curve along its tangent junctions: a cubic through many close
                             // points wiggles across the tangency band, and its curve on the
                             // flat neighbour can cross the next edge's near their vertex.
-                            if (variant == 2 && (linear[ra] || linear[rb]) &&
-                                min_sin <= std::sin(kTangentAngle) && t.deviation <= max_tol) {
+                            if (variant == 2 && (linear[ra] || linear[rb]) && tangent &&
+                                t.deviation <= max_tol) {
                                 best = t;
                                 break;
                             }
                             if (best.deviation < 0 || t.deviation < best.deviation) best = t;
                         }
                         ok = best.deviation >= 0 && best.deviation <= max_tol;
-                        touched = touching;
                         if (ok) cc = best;
                     }
                     if (ok) {
@@ -1059,8 +1011,8 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             }
             ++out.polyline_edges;
         }
-        // A chain without a curve between two surfaces: both regions become facets, since
-        // a polyline edge may lie off a curved surface by more than its tolerance allows.
+        // A chain without a curve between two surfaces: a region on either side whose facets are
+        // chords of its neighbour's surface joins it; otherwise one side becomes facets (below).
         bool changed = false;
         bool chain_absorbed = false;
         for (std::int32_t c : failed_chain) {
