@@ -6,8 +6,12 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <BRepBuilderAPI_MakeVertex.hxx>
+#include <BRepExtrema_DistShapeShape.hxx>
+#include <BRepGProp.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
 #include <BRep_Tool.hxx>
+#include <GProp_GProps.hxx>
 #include <Poly_Triangulation.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopLoc_Location.hxx>
@@ -169,6 +173,26 @@ DistanceStats stats_of(const std::vector<Vec3>& points, const TriangleGrid& grid
 }
 
 }  // namespace
+
+std::vector<std::array<double, 3>> untriangulated_faces(const TopoDS_Shape& shape,
+                                                        double deflection) {
+    std::vector<std::array<double, 3>> out;
+    BRepMesh_IncrementalMesh(shape, deflection, false, 0.2, true);
+    for (TopExp_Explorer x(shape, TopAbs_FACE); x.More(); x.Next()) {
+        const TopoDS_Face& face = TopoDS::Face(x.Current());
+        TopLoc_Location loc;
+        if (!BRep_Tool::Triangulation(face, loc).IsNull()) continue;
+        GProp_GProps props;
+        BRepGProp::SurfaceProperties(face, props);
+        gp_Pnt p = props.CentreOfMass();
+        // The centre of a curved face is off it, perhaps nearer a neighbour: its foot on the
+        // face.
+        BRepExtrema_DistShapeShape d(BRepBuilderAPI_MakeVertex(p).Vertex(), face);
+        if (d.IsDone() && d.NbSolution() > 0) p = d.PointOnShape2(1);
+        out.push_back({p.X(), p.Y(), p.Z()});
+    }
+    return out;
+}
 
 SolidDeviation measure_deviation(const TopoDS_Shape& shape, const Mesh& mesh, double deflection) {
     SolidDeviation out;

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <TopoDS_Shape.hxx>
+#include <array>
+#include <vector>
 
 #include "ncrev/brep.h"
 #include "ncrev/mesh.h"
@@ -14,6 +16,13 @@ namespace ncrev::brep_detail {
 /// distance by up to `deflection`; pass a fraction of the mesh's chordal deflection.
 /// Deterministic whatever the thread count.
 SolidDeviation measure_deviation(const TopoDS_Shape& shape, const Mesh& mesh, double deflection);
+
+/// Triangulates `shape` with BRepMesh at `deflection` (in parallel over faces; measure_deviation()
+/// then reuses it) and returns, for each face BRepMesh leaves without triangles, the point of
+/// the face nearest its centre of area. Such a face passes BRepCheck but no viewer can show it,
+/// and the deviation would not see it.
+std::vector<std::array<double, 3>> untriangulated_faces(const TopoDS_Shape& shape,
+                                                        double deflection);
 
 /// The point of triangle abc closest to p.
 Vec3 closest_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c);

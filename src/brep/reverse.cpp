@@ -187,7 +187,7 @@ std::size_t regions_near(const Mesh& mesh, const FaceMap<std::int32_t>& labels,
                          const brep_detail::SurfaceBrep& brep,
                          std::span<const brep_detail::RegionSurface> surfaces,
                          const std::vector<std::array<double, 3>>& places, double radius,
-                         std::vector<std::uint8_t>& facets_only) {
+                         const std::string& reason, std::vector<std::string>& facets_only) {
     std::size_t marked = 0;
     for (const auto& pl : places) {
         const Vec3 p{pl[0], pl[1], pl[2]};
@@ -203,14 +203,14 @@ std::size_t regions_near(const Mesh& mesh, const FaceMap<std::int32_t>& labels,
             while (brep.regions[r].absorbed_into >= 0) {
                 r = static_cast<std::size_t>(brep.regions[r].absorbed_into);
             }
-            if (brep.regions[r].fallback || facets_only[r]) continue;
+            if (brep.regions[r].fallback || !facets_only[r].empty()) continue;
             const bool plane =
                 surfaces[r].has_surface && surfaces[r].surface.kind == FitKind::kPlane;
             (plane ? flat : curved).push_back(r);
         }
         for (std::size_t r : curved.empty() ? flat : curved) {
-            if (!facets_only[r]) {
-                facets_only[r] = 1;
+            if (facets_only[r].empty()) {
+                facets_only[r] = reason;
                 ++marked;
             }
         }
@@ -324,12 +324,12 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     bo.tolerance = sr.tolerance;
     bo.chordal_deflection = std::max(sr.chordal_deflection, sr.tolerance);
     bo.allow_fallback = options.method == ReverseMethod::kAuto;
-    // Faces that pass in memory can fail once written and read back (STEP keeps no tolerances
-    // and the reader heals): their regions are found near where the read-back shape is
-    // wrong, built from their facets, and the part is built and written again, up to
+    // Faces that pass BRepCheck in memory can still be wrong: BRepMesh cannot triangulate
+    // them (no viewer shows them), or they fail once written and read back (STEP keeps no
+    // tolerances and the reader heals). Their regions are found near where the shape is
+    // wrong, built from their facets, and the part is built (and written) again, up to
     // kReadBackRetries times before the whole part goes planar.
-    bo.facets_only.assign(surfaces.size(), 0);
-    bo.facets_only_reason = "its face fails once the STEP is read back";
+    bo.facets_only.assign(surfaces.size(), std::string());
     // The last resort, so that a closed mesh always gives a valid closed solid: the whole part
     // as planar faces (that construction cannot fail), reported as one fallback.
     const auto whole_planar = [&](ReverseReport base,
@@ -353,6 +353,10 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         }
         return out;
     };
+    // The triangulation for the deviation: fine enough for the figures to reflect the mesh's
+    // own chordal error (it may add up to this much).
+    const double deflection = 0.5 * std::max(sr.chordal_deflection, sr.tolerance);
+    bo.mesh_deflection = deflection;
     const ReverseReport before_brep = rep;
     for (int attempt = 0;; ++attempt) {
         if (attempt > 0) {
@@ -361,6 +365,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             rep.stage_seconds = std::move(stages);
         }
         brep_detail::SurfaceBrep brep;
+        std::vector<std::array<double, 3>> unmeshed;
         stage("brep", [&] { brep = brep_detail::build_surface_brep(mesh, labels, surfaces, bo); });
         rep.corners = brep.corners;
         rep.max_corner_residual = brep.max_corner_residual;
@@ -411,10 +416,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                             (rep.solid_volume - rep.mesh_volume) / rep.mesh_volume;
                     }
                 }
-                if (options.measure_deviation && rep.valid) {
-                    rep.deviation = brep_detail::measure_deviation(
-                        brep.shape, mesh, 0.5 * std::max(sr.chordal_deflection, sr.tolerance));
-                }
+                if (rep.valid) unmeshed = brep_detail::untriangulated_faces(brep.shape, deflection);
             });
         }
         for (const ReverseFallback& fb : rep.fallbacks) {
@@ -434,6 +436,13 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                                    (brep.problem.empty() ? std::string("unknown") : brep.problem) +
                                    "): nothing written");
             return rep;
+        }
+        if (!unmeshed.empty() && options.method == ReverseMethod::kAuto &&
+            attempt < kReadBackRetries &&
+            regions_near(mesh, labels, brep, surfaces, unmeshed,
+                         2 * std::max(bo.chordal_deflection, brep.max_tolerance),
+                         "BRepMesh cannot triangulate its face", bo.facets_only) > 0) {
+            continue;
         }
         Status written = Ok{};
         stage("step", [&] {
@@ -467,9 +476,10 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         const std::string& back_problem = back.problem;
         if (!back_problem.empty() && options.method == ReverseMethod::kAuto &&
             attempt < kReadBackRetries) {
-            const std::size_t found = regions_near(
-                mesh, labels, brep, surfaces, back.places,
-                2 * std::max(bo.chordal_deflection, brep.max_tolerance), bo.facets_only);
+            const std::size_t found =
+                regions_near(mesh, labels, brep, surfaces, back.places,
+                             2 * std::max(bo.chordal_deflection, brep.max_tolerance),
+                             "its face fails once the STEP is read back", bo.facets_only);
             if (found > 0) continue;
         }
         if (!back_problem.empty()) {
@@ -484,6 +494,17 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             rep.warnings.push_back("the STEP reads back invalid (" + back_problem +
                                    "): nothing written");
             return rep;
+        }
+        // Measured once, on the solid that was written (the triangulation is reused).
+        if (options.measure_deviation) {
+            stage("measure", [&] {
+                rep.deviation = brep_detail::measure_deviation(brep.shape, mesh, deflection);
+            });
+            if (rep.deviation->faces_without_triangles > 0) {
+                rep.warnings.push_back(
+                    std::to_string(rep.deviation->faces_without_triangles) +
+                    " faces BRepMesh cannot triangulate: the deviation does not see them");
+            }
         }
         return mark_written(std::move(rep), output);
     }

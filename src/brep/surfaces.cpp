@@ -22,6 +22,8 @@
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepLib.hxx>
+#include <BRepMesh_IncrementalMesh.hxx>
+#include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <GeomAPI_IntSS.hxx>
@@ -91,6 +93,10 @@ constexpr std::size_t kOrientationSamples = 16;
 // Build rounds: each round turns (the smallest of) the regions whose faces failed into facets;
 // a failure spreads at most to neighbours, so a few rounds settle.
 constexpr int kMaxRounds = 12;
+// Why a face BRepMesh leaves without triangles fails (its boundary crosses itself at the
+// mesher's resolution: like a self-intersecting wire, it first gets piecewise-linear edges
+// along its tangent junctions).
+constexpr const char* kUntriangulated = "BRepMesh cannot triangulate its face";
 
 gp_Pnt pnt(Vec3 v) { return {v.x, v.y, v.z}; }
 Vec3 vec(const gp_Pnt& p) { return {p.X(), p.Y(), p.Z()}; }
@@ -512,6 +518,23 @@ bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, C
         if (p.empty() || p.back().Distance(q) > 10 * kMinTolerance) p.push_back(q);
     }
     if (closed && p.size() > 1 && p.back().Distance(p.front()) <= 10 * kMinTolerance) p.pop_back();
+    if (!closed) {
+        // A chain point behind its neighbours (the curve would turn back by more than a right
+        // angle there) is dropped: a corner solved a little past the chain's first interior
+        // vertex, or an interior point that slid along a tangent junction, would otherwise
+        // fold the curve back on itself (a self-intersecting wire on the surface).
+        std::vector<gp_Pnt> kept;
+        kept.reserve(p.size());
+        for (const gp_Pnt& q : p) {
+            // kept[0] is the chain's first end and never dropped; `q` may be the last.
+            while (kept.size() >= 2 &&
+                   gp_Vec(kept[kept.size() - 2], kept.back()).Dot(gp_Vec(kept.back(), q)) < 0) {
+                kept.pop_back();
+            }
+            kept.push_back(q);
+        }
+        p = std::move(kept);
+    }
     if (p.size() < (closed ? 3u : 2u)) return false;
     if (linear) {
         if (closed) p.push_back(p.front());
@@ -714,8 +737,8 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     const auto compute_geometry = [&] {
         for (std::size_t r = 0; r < nr; ++r) {
             if (absorbed[r] >= 0 || fallback[r]) continue;
-            if (r < opt.facets_only.size() && opt.facets_only[r]) {
-                fall_back(r, opt.facets_only_reason);
+            if (r < opt.facets_only.size() && !opt.facets_only[r].empty()) {
+                fall_back(r, opt.facets_only[r]);
                 continue;
             }
             if (!regions[r].has_surface) {
@@ -1125,6 +1148,17 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                                                "its face fails OpenCASCADE's check (" + why + ")");
                     continue;
                 }
+                if (opt.mesh_deflection > 0) {
+                    BRepMesh_IncrementalMesh(F, opt.mesh_deflection, false, 0.2, false);
+                    TopLoc_Location loc;
+                    if (BRep_Tool::Triangulation(F, loc).IsNull()) {
+                        failed_region.emplace_back(r, std::string(kUntriangulated));
+                        continue;
+                    }
+                    // Not kept: neighbours' fixes may still replace its edges, which would
+                    // leave the triangulation's edge polygons stale.
+                    BRepTools::Clean(F);
+                }
                 faces[r].push_back(F);
             } catch (const Standard_Failure& f) {
                 failed_region.emplace_back(
@@ -1170,7 +1204,8 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             // get another round (all of them in the last).
             bool retry = false;
             for (const auto& [r, why] : failed_region) {
-                if (!linear[r] && why.find("SelfIntersectingWire") != std::string::npos) {
+                if (!linear[r] && (why.find("SelfIntersectingWire") != std::string::npos ||
+                                   why == kUntriangulated)) {
                     linear[r] = 1;
                     retry = true;
                 }

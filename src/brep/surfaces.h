@@ -30,10 +30,13 @@ struct SurfaceBrepOptions {
     double chordal_deflection = 0;
     /// A region whose face cannot be built comes back as its facets (true), or the build fails.
     bool allow_fallback = true;
-    /// Per region (may be empty): built from its facets from the start, with
-    /// `facets_only_reason` (its face came back wrong from a STEP file written before).
-    std::vector<std::uint8_t> facets_only;
-    std::string facets_only_reason;
+    /// When positive, each face is also triangulated with BRepMesh at this deflection and
+    /// fails when it cannot be (it passes BRepCheck, but no viewer or FE mesher could use it).
+    double mesh_deflection = 0;
+    /// Per region (may be empty): built from its facets from the start where not empty, with
+    /// this as the reason (its face came back wrong from a STEP file written before, or
+    /// BRepMesh could not triangulate it).
+    std::vector<std::string> facets_only;
 };
 
 /// What happened to one region.

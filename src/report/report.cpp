@@ -202,7 +202,8 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
         };
         r["deviation"] = {{"mesh_to_solid", stats(rev.deviation->mesh_to_solid)},
                           {"solid_to_mesh", stats(rev.deviation->solid_to_mesh)},
-                          {"triangulation_deflection", rev.deviation->deflection}};
+                          {"triangulation_deflection", rev.deviation->deflection},
+                          {"faces_without_triangles", rev.deviation->faces_without_triangles}};
     }
     for (const std::string& w : rev.warnings) j["warnings"].push_back(w);
     return j.dump(indent);
