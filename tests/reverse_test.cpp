@@ -6,11 +6,16 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepGProp.hxx>
+#include <GProp_GProps.hxx>
 #include <Quantity_Color.hxx>
 #include <STEPCAFControl_Reader.hxx>
 #include <TDF_LabelSequence.hxx>
 #include <TDocStd_Document.hxx>
 #include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Face.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
@@ -297,8 +302,12 @@ TEST(ReverseSurfaces, RealPartsFaceForFace) {
 // A finer tessellation of a real part (NIST CTC 03 at 0.02 mm, 17k facets, as the benchmark
 // runs it): its fillet edges have many more chain points, and a corner solved a little past
 // the first of them used to fold the edge curve back on itself (self-intersecting wires, then
-// neighbours' faces with them: 983 faces, 6 regions as facets). At most one region (a plane
-// strip between two tangent cylinders that segmentation fits as a cone) falls back now.
+// neighbours' faces with them: 983 faces, 6 regions as facets). And where segmentation's
+// border runs beside a tangent junction rather than on it (a plane strip between two tangent
+// cylinders, with their first facet rows, fitted as one cone), a corner solved onto the
+// surfaces stays anywhere in the band sqrt(2 r tol) wide where they are within the tolerance of
+// each other: the cylinders came out 2 % short in area. Corners now go onto the contact line
+// where the other surfaces cross it: the curved faces get their area back.
 TEST(ReverseSurfaces, FineRealPartKeepsItsFaces) {
     const auto path = corpus_step_dir() / "nist_ctc_03_asme1_rc.stp";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
@@ -314,6 +323,22 @@ TEST(ReverseSurfaces, FineRealPartKeepsItsFaces) {
     EXPECT_LE(o.report.faces, o.true_faces + 45);
     ASSERT_TRUE(o.report.deviation.has_value());
     EXPECT_EQ(o.report.deviation->faces_without_triangles, 0u);
+    EXPECT_GT(o.report.tangent_corners, 0u);
+    double true_curved = 0, curved = 0;
+    for (const SampleFace& f : made.value().faces) {
+        if (f.kind != "plane") true_curved += f.area;
+    }
+    for (TopExp_Explorer x(o.back.shape, TopAbs_FACE); x.More(); x.Next()) {
+        const TopoDS_Face& face = TopoDS::Face(x.Current());
+        const GeomAbs_SurfaceType type = BRepAdaptor_Surface(face).GetType();
+        if (type == GeomAbs_Plane || type == GeomAbs_Cone) continue;  // the strip's cone too
+        GProp_GProps props;
+        BRepGProp::SurfaceProperties(face, props);
+        curved += props.Mass();
+    }
+    // 2 % short with every corner solved plainly; 0.2 % where one chain's ends, past the
+    // contact on the fillet's first row, still need it.
+    EXPECT_NEAR(curved, true_curved, 5e-3 * true_curved);
 }
 
 // The table of docs/results.md:

@@ -112,6 +112,9 @@ struct ReverseReport {
     /// exact contact), fitted, polyline.
     std::map<std::string, std::uint64_t> edges_by_curve;
     std::uint64_t corners = 0;
+    /// Of those, the corners put on the contact curve of two tangent surfaces (a fillet and
+    /// its neighbour), where the other surfaces cross it.
+    std::uint64_t tangent_corners = 0;
     double max_corner_residual = 0;  ///< largest distance of a solved corner from its surfaces
     double max_tolerance = 0;        ///< largest vertex or edge tolerance of the B-rep
     double chordal_deflection = 0;   ///< the mesh's, as segmentation estimated it

@@ -180,14 +180,17 @@ std::vector<std::int64_t> region_colors(const Mesh& mesh, const SegmentResult& s
     return out;
 }
 
-// Marks in `facets_only` the surface regions (not yet fallback) with a facet within `radius`
-// of one of `places`: the curved ones, or the planes where no curved one is there (planes
-// rarely fail; the curved faces beside them do). Returns how many it marked.
+// Marks the surface regions (not yet fallback) with a facet within `radius` of one of
+// `places` — the curved ones, or the planes where no curved one is there (planes rarely fail;
+// the curved faces beside them do) — to be built again: with plain corners if some were put on
+// contact curves and that has not been tried, else from their facets (`facets_only`, with
+// `reason`). Returns how many it marked.
 std::size_t regions_near(const Mesh& mesh, const FaceMap<std::int32_t>& labels,
                          const brep_detail::SurfaceBrep& brep,
                          std::span<const brep_detail::RegionSurface> surfaces,
                          const std::vector<std::array<double, 3>>& places, double radius,
-                         const std::string& reason, std::vector<std::string>& facets_only) {
+                         const std::string& reason, brep_detail::SurfaceBrepOptions& bo) {
+    std::vector<std::string>& facets_only = bo.facets_only;
     std::size_t marked = 0;
     for (const auto& pl : places) {
         const Vec3 p{pl[0], pl[1], pl[2]};
@@ -209,7 +212,11 @@ std::size_t regions_near(const Mesh& mesh, const FaceMap<std::int32_t>& labels,
             (plane ? flat : curved).push_back(r);
         }
         for (std::size_t r : curved.empty() ? flat : curved) {
-            if (facets_only[r].empty()) {
+            // First without the corners moved onto contact curves, if it had any; then facets.
+            if (brep.regions[r].contact_corners && !bo.plain_corners[r]) {
+                bo.plain_corners[r] = 1;
+                ++marked;
+            } else if (facets_only[r].empty()) {
                 facets_only[r] = reason;
                 ++marked;
             }
@@ -330,6 +337,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     // wrong, built from their facets, and the part is built (and written) again, up to
     // kReadBackRetries times before the whole part goes planar.
     bo.facets_only.assign(surfaces.size(), std::string());
+    bo.plain_corners.assign(surfaces.size(), 0);
     // The last resort, so that a closed mesh always gives a valid closed solid: the whole part
     // as planar faces (that construction cannot fail), reported as one fallback.
     const auto whole_planar = [&](ReverseReport base,
@@ -368,6 +376,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         std::vector<std::array<double, 3>> unmeshed;
         stage("brep", [&] { brep = brep_detail::build_surface_brep(mesh, labels, surfaces, bo); });
         rep.corners = brep.corners;
+        rep.tangent_corners = brep.tangent_corners;
         rep.max_corner_residual = brep.max_corner_residual;
         rep.max_tolerance = brep.max_tolerance;
         rep.edges_by_curve = {{"intersection", brep.intersection_edges},
@@ -441,7 +450,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             attempt < kReadBackRetries &&
             regions_near(mesh, labels, brep, surfaces, unmeshed,
                          2 * std::max(bo.chordal_deflection, brep.max_tolerance),
-                         "BRepMesh cannot triangulate its face", bo.facets_only) > 0) {
+                         "BRepMesh cannot triangulate its face", bo) > 0) {
             continue;
         }
         Status written = Ok{};
@@ -479,7 +488,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             const std::size_t found =
                 regions_near(mesh, labels, brep, surfaces, back.places,
                              2 * std::max(bo.chordal_deflection, brep.max_tolerance),
-                             "its face fails once the STEP is read back", bo.facets_only);
+                             "its face fails once the STEP is read back", bo);
             if (found > 0) continue;
         }
         if (!back_problem.empty()) {

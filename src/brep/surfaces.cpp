@@ -72,6 +72,7 @@
 #include <map>
 #include <numbers>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "brep/check.h"
 #include "ncrev/segment.h"
@@ -460,6 +461,73 @@ bool tangency_points(const Surface& a, const Surface& b, const Mesh& m,
     return true;
 }
 
+// A corner where two of its surfaces are tangent, one of them a tube (a fillet running into
+// its plane or into another fillet): common_point() leaves it about where the mesh vertex was,
+// anywhere in the band where the two are within the tolerance of each other (sqrt(2 r tol)
+// across: 1.9 mm for a 30 mm radius at 0.06 mm), which cuts the fillet's face short or long by
+// that much. The corner is where their contact curve meets the other surfaces: alternately the
+// contact point nearest (the foot of the tube's spine, as tangency_points()) and the step along
+// the spine's direction that puts it on the others. False (and `p` unchanged) when no such
+// pair is there, or the other surfaces do not fix the point along the contact.
+bool tangent_corner(std::span<const Surface> on, double tolerance, Vec3& p, double& tube_radius) {
+    constexpr int kSteps = 20;
+    const double sin_tangent = std::sin(kTangentAngle);
+    for (std::size_t i = 0; i < on.size(); ++i) {
+        for (std::size_t j = i + 1; j < on.size(); ++j) {
+            if (norm(cross(normal_at(on[i], p), normal_at(on[j], p))) > sin_tangent) continue;
+            Vec3 c;
+            double ri = 0, rj = 0;
+            const bool ti = spine_point(on[i], p, c, ri), tj = spine_point(on[j], p, c, rj);
+            if (!ti && !tj) continue;
+            const bool i_tube = ti && (!tj || ri <= rj);
+            const Surface& tube = i_tube ? on[i] : on[j];
+            const Surface& other = i_tube ? on[j] : on[i];
+            if (tube.kind == FitKind::kSphere) continue;  // a sphere's contact has no direction
+            Vec3 q = p;
+            bool fixed = true;
+            for (int step = 0; step < kSteps; ++step) {
+                double radius = 0;
+                if (!spine_point(tube, q, c, radius)) return false;
+                Vec3 c2;
+                double r2 = 0;
+                if (spine_point(other, c, c2, r2) && norm(c2 - c) <= tolerance) {
+                    if (norm(q - c) <= 0) return false;
+                    q = c + radius * normalized(q - c);
+                } else {
+                    q = closest_point(other, c);
+                }
+                const Vec3 axis = normalized(tube.axis);
+                const Vec3 t =
+                    tube.kind == FitKind::kCylinder
+                        ? axis
+                        : normalized(cross(axis, perpendicular_part(c - tube.point, axis)));
+                // Least squares along t onto the remaining surfaces (linearised).
+                double num = 0, den = 0;
+                for (std::size_t k = 0; k < on.size(); ++k) {
+                    if (k == i || k == j) continue;
+                    const Vec3 n = normal_at(on[k], q);
+                    const double f = dot(q - closest_point(on[k], q), n);
+                    const double g = dot(n, t);
+                    num += f * g;
+                    den += g * g;
+                }
+                if (den <= sin_tangent * sin_tangent) {
+                    fixed = false;
+                    break;
+                }
+                const double move = -num / den;
+                q = q + move * t;
+                if (std::abs(move) <= 1e-12 * (1 + norm(q))) break;
+            }
+            if (!fixed) continue;
+            p = q;
+            tube_radius = i_tube ? ri : rj;
+            return true;
+        }
+    }
+    return false;
+}
+
 // Whether `c` leaves the polyline through `points` by more than `accept` between them: the
 // chain's points lie on a branch that bulges away between them (an ellipse arc between two
 // close corners of a steep plane on a cylinder), or only the ends were there to check.
@@ -734,6 +802,14 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     std::vector<std::int32_t> absorbed(nr, -1);
     // Regions whose tangent junctions take piecewise-linear edges (after a self-crossing wire).
     std::vector<std::uint8_t> linear(nr, 0);
+    // Regions whose corners are solved without tangent_corner() (opt.plain_corners: their face
+    // came back wrong from a STEP written with them).
+    std::vector<std::uint8_t> plain_corners(nr, 0);
+    for (std::size_t r = 0; r < std::min(nr, opt.plain_corners.size()); ++r)
+        plain_corners[r] = opt.plain_corners[r];
+    // Corners (mesh vertex ids) solved without it after a face or chain at them failed with it
+    // (a corner moved along a coarse mesh's contact band can pass its chain's next point).
+    std::unordered_set<std::uint32_t> plain_at;
     const auto compute_geometry = [&] {
         for (std::size_t r = 0; r < nr; ++r) {
             if (absorbed[r] >= 0 || fallback[r]) continue;
@@ -840,24 +916,56 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         out.rounds = round;
         out.intersection_edges = out.tangency_edges = out.fitted_edges = out.polyline_edges = 0;
         out.analytic_edges = 0;
-        out.corners = 0;
+        out.corners = out.tangent_corners = 0;
         out.max_corner_residual = 0;
         // 2. Vertices: solved corners (and loop starts); other mesh vertices at their place.
         std::unordered_map<std::uint32_t, TopoDS_Vertex> vertex;
+        // Per region, its corners put on a contact curve this round.
+        std::vector<std::vector<std::uint32_t>> contact_at(nr);
+        const auto contact_corner = [&](std::size_t r) { return !contact_at[r].empty(); };
+        // Back to plain for the next round: the corners of region r that were on a contact
+        // curve (false when it had none).
+        const auto make_plain = [&](std::size_t r) {
+            for (std::uint32_t v : contact_at[r]) plain_at.insert(v);
+            return contact_corner(r);
+        };
         const auto solved_vertex = [&](VertexId v) -> TopoDS_Vertex {
             auto it = vertex.find(v.idx());
             if (it != vertex.end()) return it->second;
             std::vector<Surface> on;
-            for (std::int32_t r : regions_at(v)) {
-                if (!fallback[static_cast<std::size_t>(r)]) {
-                    on.push_back(regions[static_cast<std::size_t>(r)].surface);
-                }
+            const std::vector<std::int32_t> around = regions_at(v);
+            bool contact_allowed = true;
+            for (std::int32_t r : around) {
+                const auto k = static_cast<std::size_t>(r);
+                if (!fallback[k]) on.push_back(regions[k].surface);
+                if (plain_corners[k] || plain_at.count(v.idx())) contact_allowed = false;
             }
             Vec3 p = m.position(v);
             double tol = kMinTolerance;
             if (!on.empty()) {
-                const CommonPoint cp = common_point(on, p);
-                if (cp.residual <= opt.tolerance && norm(cp.point - p) <= max_tol) {
+                CommonPoint cp = common_point(on, p);
+                // Two tangent surfaces leave the solve free along their contact band: the
+                // corner goes onto their contact curve when that is within the tolerance of
+                // every surface and within the band (its half-width sqrt(2 r tol), r the
+                // tube's radius).
+                Vec3 q = cp.point;
+                bool on_contact = false;
+                double radius = 0;
+                if (contact_allowed && on.size() >= 3 &&
+                    tangent_corner(on, opt.tolerance, q, radius)) {
+                    double residual = 0;
+                    for (const Surface& s : on) residual = std::max(residual, distance(s, q));
+                    const double band = std::sqrt(2 * radius * opt.tolerance);
+                    if (residual <= opt.tolerance && norm(q - p) <= max_tol + 2 * band) {
+                        cp.point = q;
+                        cp.residual = residual;
+                        on_contact = true;
+                        ++out.tangent_corners;
+                        for (std::int32_t r : around)
+                            contact_at[static_cast<std::size_t>(r)].push_back(v.idx());
+                    }
+                }
+                if (cp.residual <= opt.tolerance && (on_contact || norm(cp.point - p) <= max_tol)) {
                     p = cp.point;
                     tol = std::max(tol, 1.01 * cp.residual);
                     out.max_corner_residual = std::max(out.max_corner_residual, cp.residual);
@@ -1052,6 +1160,19 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             relabelled();
             continue;
         }
+        // A chain whose end moved onto a contact curve: first again with plain corners.
+        bool chain_plain_retry = false;
+        for (std::int32_t c : failed_chain) {
+            const BorderChain& ch = borders.chains[static_cast<std::size_t>(c)];
+            for (const VertexId end : {ch.vertices.front(), ch.vertices.back()}) {
+                const auto& at = contact_at[static_cast<std::size_t>(ch.left)];
+                if (std::find(at.begin(), at.end(), end.idx()) != at.end() &&
+                    plain_at.insert(end.idx()).second) {
+                    chain_plain_retry = true;
+                }
+            }
+        }
+        if (chain_plain_retry && round < kMaxRounds) continue;
         // Only the smaller of the two becomes facets: the chain is then its polyline of mesh
         // edges, chords of the larger region's surface like every edge between a surface face
         // and fallback facets (a 215-facet plane went to facets for a 30-facet fillet's sake).
@@ -1204,13 +1325,14 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             // get another round (all of them in the last).
             bool retry = false;
             for (const auto& [r, why] : failed_region) {
+                if (make_plain(r)) retry = true;
                 if (!linear[r] && (why.find("SelfIntersectingWire") != std::string::npos ||
                                    why == kUntriangulated)) {
                     linear[r] = 1;
                     retry = true;
                 }
             }
-            if (retry) continue;
+            if (retry && round < kMaxRounds) continue;
             bool absorbed_any = false;
             for (const auto& [r, why] : failed_region) absorbed_any = try_absorb(r) || absorbed_any;
             if (absorbed_any) {
@@ -1273,6 +1395,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             }
         }
         for (std::size_t r = 0; r < nr; ++r) {
+            out.regions[r].contact_corners = contact_corner(r);
             out.regions[r].faces.clear();
             for (const TopoDS_Face& f : faces[r]) {
                 out.regions[r].faces.push_back(TopoDS::Face(context->Value(f)));
@@ -1324,6 +1447,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             }
         }
         if (bad_regions.empty()) break;
+        bool plain_retry = false;
+        for (std::size_t r : bad_regions) plain_retry = make_plain(r) || plain_retry;
+        if (plain_retry && round < kMaxRounds) continue;
         bool solid_absorbed = false;
         for (std::size_t r : bad_regions) {
             if (bd.facets[r] > 0) solid_absorbed = try_absorb(r) || solid_absorbed;

@@ -37,6 +37,9 @@ struct SurfaceBrepOptions {
     /// this as the reason (its face came back wrong from a STEP file written before, or
     /// BRepMesh could not triangulate it).
     std::vector<std::string> facets_only;
+    /// Per region (may be empty): its corners are solved without moving them onto the contact
+    /// curve of two tangent surfaces (after its face failed with them).
+    std::vector<std::uint8_t> plain_corners;
 };
 
 /// What happened to one region.
@@ -47,6 +50,8 @@ struct RegionBuild {
     /// The region whose face took its facets (a sliver whose own face failed and whose facets
     /// are chords of that neighbour's surface); -1 when not absorbed.
     std::int32_t absorbed_into = -1;
+    /// A corner of its face was put on the contact curve of two tangent surfaces.
+    bool contact_corners = false;
 };
 
 struct SurfaceBrep {
@@ -65,6 +70,8 @@ struct SurfaceBrep {
     /// ellipse where two elementary surfaces meet).
     std::uint64_t analytic_edges = 0;
     std::uint64_t corners = 0;
+    std::uint64_t tangent_corners =
+        0;                           ///< corners put on the contact curve of two tangent surfaces
     double max_corner_residual = 0;  ///< largest distance of a solved corner from its surfaces
     double max_tolerance = 0;        ///< largest vertex / edge / face tolerance of the result
     int rounds = 0;                  ///< build rounds (each one after new fallbacks)

@@ -192,6 +192,7 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
         r["absorbed_regions"] = rev.absorbed_regions;
         r["edges_by_curve"] = rev.edges_by_curve;
         r["corners"] = rev.corners;
+        r["tangent_corners"] = rev.tangent_corners;
         r["max_corner_residual"] = rev.max_corner_residual;
         r["max_tolerance"] = rev.max_tolerance;
         r["volume_difference"] = rev.volume_difference;
