@@ -123,9 +123,21 @@ class TriangleGrid {
                     }
                 }
             }
-            // Every triangle not yet seen is at least `ring` cells away (the point is
-            // inside its clamped cell, or outside the grid, which only makes them farther).
-            const double reach = ring * cell_;
+            // Every triangle not yet seen is in a cell outside the block searched: at least
+            // `ring` cells away (the point is inside its clamped cell, or outside the grid,
+            // which only makes them farther), and at least as far as the block's nearest side
+            // that has cells beyond it — most points lie on the other mesh, and stop at ring 0
+            // instead of searching the 26 cells around theirs.
+            double reach = ring * cell_;
+            double side = 1e300;
+            for (int k = 0; k < 3; ++k) {
+                const double lo = coord(box_.min, k), v = coord(p, k);
+                if (c[k] - ring > 0) side = std::min(side, v - (lo + (c[k] - ring) * cell_));
+                if (c[k] + ring < n_[k] - 1) {
+                    side = std::min(side, lo + (c[k] + ring + 1) * cell_ - v);
+                }
+            }
+            reach = std::max(reach, side);
             if (best2 < 1e300 && best2 <= reach * reach) break;
         }
         return std::sqrt(best2);
