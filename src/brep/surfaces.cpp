@@ -424,6 +424,24 @@ bool spine_point(const Surface& s, Vec3 p, Vec3& c, double& radius) {
     }
 }
 
+// Where `tube` touches the tangent surface `other` nearest `p`: the foot on `other` of the
+// tube's spine point `c` nearest p. Two tubes whose spines meet (a corner torus running into
+// the edge fillet of the same radius) touch along a whole section: every point of it is a foot,
+// and p says which. False where p has no spine point (a torus's axis) or lies on the spine.
+bool contact_point(const Surface& tube, const Surface& other, Vec3 p, double tolerance, Vec3& c,
+                   double& radius, Vec3& out) {
+    if (!spine_point(tube, p, c, radius)) return false;
+    Vec3 c2;
+    double r2 = 0;
+    if (spine_point(other, c, c2, r2) && norm(c2 - c) <= tolerance) {
+        if (norm(p - c) <= 0) return false;
+        out = c + radius * normalized(p - c);
+    } else {
+        out = closest_point(other, c);
+    }
+    return true;
+}
+
 // Where two tangent surfaces touch along a chain: one of them a tube (the one of smaller radius
 // when both are), the foot on the other of the tube's spine point nearest each chain vertex.
 // False when neither is a tube, or a foot is not at the tube's radius from its spine within
@@ -441,20 +459,9 @@ bool tangency_points(const Surface& a, const Surface& b, const Mesh& m,
     const Surface& other = a_tube ? b : a;
     out.clear();
     for (VertexId v : chain) {
-        const Vec3 p = m.position(v);
         double radius = 0;
-        if (!spine_point(tube, p, c, radius)) return false;
-        // Two tubes whose spines meet (a corner torus running into the edge fillet of the
-        // same radius): every point of their common section is a foot; the chain's vertex
-        // says which.
-        Vec3 c2;
-        double r2 = 0;
-        if (spine_point(other, c, c2, r2) && norm(c2 - c) <= tolerance) {
-            if (norm(p - c) <= 0) return false;
-            out.push_back(pnt(c + radius * normalized(p - c)));
-            continue;
-        }
-        const Vec3 q = closest_point(other, c);
+        Vec3 q;
+        if (!contact_point(tube, other, m.position(v), tolerance, c, radius, q)) return false;
         if (std::abs(norm(q - c) - radius) > tolerance) return false;
         out.push_back(pnt(q));
     }
@@ -466,7 +473,7 @@ bool tangency_points(const Surface& a, const Surface& b, const Mesh& m,
 // anywhere in the band where the two are within the tolerance of each other (sqrt(2 r tol)
 // across: 1.9 mm for a 30 mm radius at 0.06 mm), which cuts the fillet's face short or long by
 // that much. The corner is where their contact curve meets the other surfaces: alternately the
-// contact point nearest (the foot of the tube's spine, as tangency_points()) and the step along
+// contact point nearest (contact_point(), as tangency_points()) and the step along
 // the spine's direction that puts it on the others. False (and `p` unchanged) when no such
 // pair is there, or the other surfaces do not fix the point along the contact.
 bool tangent_corner(std::span<const Surface> on, double tolerance, Vec3& p, double& tube_radius) {
@@ -487,15 +494,7 @@ bool tangent_corner(std::span<const Surface> on, double tolerance, Vec3& p, doub
             bool fixed = true;
             for (int step = 0; step < kSteps; ++step) {
                 double radius = 0;
-                if (!spine_point(tube, q, c, radius)) return false;
-                Vec3 c2;
-                double r2 = 0;
-                if (spine_point(other, c, c2, r2) && norm(c2 - c) <= tolerance) {
-                    if (norm(q - c) <= 0) return false;
-                    q = c + radius * normalized(q - c);
-                } else {
-                    q = closest_point(other, c);
-                }
+                if (!contact_point(tube, other, q, tolerance, c, radius, q)) return false;
                 const Vec3 axis = normalized(tube.axis);
                 const Vec3 t =
                     tube.kind == FitKind::kCylinder
