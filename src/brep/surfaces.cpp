@@ -801,11 +801,6 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     std::vector<std::int32_t> absorbed(nr, -1);
     // Regions whose tangent junctions take piecewise-linear edges (after a self-crossing wire).
     std::vector<std::uint8_t> linear(nr, 0);
-    // Regions whose corners are solved without tangent_corner() (opt.plain_corners: their face
-    // came back wrong from a STEP written with them).
-    std::vector<std::uint8_t> plain_corners(nr, 0);
-    for (std::size_t r = 0; r < std::min(nr, opt.plain_corners.size()); ++r)
-        plain_corners[r] = opt.plain_corners[r];
     // Corners (mesh vertex ids) solved without it after a face or chain at them failed with it
     // (a corner moved along a coarse mesh's contact band can pass its chain's next point).
     std::unordered_set<std::uint32_t> plain_at;
@@ -933,11 +928,13 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             if (it != vertex.end()) return it->second;
             std::vector<Surface> on;
             const std::vector<std::int32_t> around = regions_at(v);
-            bool contact_allowed = true;
+            // Not on a contact curve where that failed here before, or around a region whose
+            // face came back wrong from a STEP written with one (opt.plain_corners).
+            bool contact_allowed = plain_at.count(v.idx()) == 0;
             for (std::int32_t r : around) {
                 const auto k = static_cast<std::size_t>(r);
                 if (!fallback[k]) on.push_back(regions[k].surface);
-                if (plain_corners[k] || plain_at.count(v.idx())) contact_allowed = false;
+                if (k < opt.plain_corners.size() && opt.plain_corners[k]) contact_allowed = false;
             }
             Vec3 p = m.position(v);
             double tol = kMinTolerance;

@@ -70,8 +70,8 @@ struct SurfaceBrep {
     /// ellipse where two elementary surfaces meet).
     std::uint64_t analytic_edges = 0;
     std::uint64_t corners = 0;
-    std::uint64_t tangent_corners =
-        0;                           ///< corners put on the contact curve of two tangent surfaces
+    /// Of those, the corners put on the contact curve of two tangent surfaces.
+    std::uint64_t tangent_corners = 0;
     double max_corner_residual = 0;  ///< largest distance of a solved corner from its surfaces
     double max_tolerance = 0;        ///< largest vertex / edge / face tolerance of the result
     int rounds = 0;                  ///< build rounds (each one after new fallbacks)
