@@ -61,6 +61,14 @@ constexpr double kSagFactor = 2;
 constexpr double kFlatDihedral = 1e-3;
 /// The share of a region's area whose facet normals may disagree with its surface.
 constexpr double kNormalOutlierArea = 0.02;
+/// How far a facet's middle may lie from its surface, in chordal deflections (the sag estimate
+/// measures edges). A triangle's middle sags more than its edges' middles: 4/3 as much on a
+/// sphere, more for a fan triangle on a torus whose corners lie on two of its circles —
+/// BRepMesh's fans on NIST FTC 11's bull-nose tori sag 1.3 x the estimate with every corner on
+/// the torus, and came back as dozens of one-facet planes. A facet whose three corners lie on
+/// the surface and whose middle is 2 deflections off is still a chord of it; one that bridges
+/// two faces (a cap triangle on a bore's rim) is off by the bore's radius.
+constexpr double kMiddleSagFactor = 2;
 /// A plane with at least this share of the area of the regions smoothly joined to it is a face,
 /// not a piece of a free-form face.
 constexpr double kFreeformPlaneShare = 0.1;
@@ -240,14 +248,15 @@ bool normal_agrees(const Context& c, const Surface& s, std::uint32_t f) {
 }
 
 /// How badly facet f fits s: the largest distance of its corners; infinite when its normal
-/// disagrees with the surface's or its middle is further from the surface than the mesh's
-/// chordal deflection (a chord of the surface: corners on it, middle within the sag).
+/// disagrees with the surface's or its middle is further from the surface than
+/// kMiddleSagFactor chordal deflections (a chord of the surface: corners on it, middle within
+/// the sag).
 double facet_cost(const Context& c, const Surface& s, std::uint32_t f, bool check_normal = true) {
     double worst = 0;
     for (int i = 0; i < 3; ++i)
         worst = std::max(worst, distance(s, c.m.position(c.m.vertex(fid(f), i))));
     if (worst > c.tol) return worst;
-    if (distance(s, c.fd.centroid[f]) > c.sag) return kInf;
+    if (distance(s, c.fd.centroid[f]) > kMiddleSagFactor * c.sag) return kInf;
     return !check_normal || normal_agrees(c, s, f) ? worst : kInf;
 }
 
