@@ -34,7 +34,8 @@ void add_reverse(CLI::App& app, Context& ctx) {
         "(default) segments the mesh into regions (an SRE file's surface indices kept), fits "
         "each one surface (plane, cylinder, cone, sphere, torus, B-spline) and builds one "
         "face per region, its edges where the surfaces meet; a region whose face cannot be "
-        "built comes back as its facets and is reported. 'surfaces' is the same but fails "
+        "built comes back as one face on its surface bounded by its mesh edges (or, where that "
+        "fails too, as its facets) and is reported. 'surfaces' is the same but fails "
         "(exit 3, nothing written) rather than fall back. 'planar' merges coplanar facets "
         "into planar faces; 'facets' gives one planar face per facet (the paper's method 1). "
         "A closed mesh gives a solid; an open one a shell (a surface model, planar method) "
@@ -46,7 +47,8 @@ void add_reverse(CLI::App& app, Context& ctx) {
                                                        {"facets", ReverseMethod::kFacets},
                                                        {"planar", ReverseMethod::kPlanar}};
     cmd->add_option("--method", o->method,
-                    "auto (default): true surfaces, regions that fail as facets; surfaces: "
+                    "auto (default): true surfaces, a region that fails as one face bounded by "
+                    "its mesh edges (or as its facets); surfaces: "
                     "true surfaces or nothing; planar: coplanar facets merged; facets: one face "
                     "per facet")
         ->transform(CLI::CheckedTransformer(methods, CLI::ignore_case))

@@ -6,7 +6,9 @@
 //    sheared kinds from SRE, B-spline), edges where the surfaces meet, trimmed at the corners
 //    solved onto them; fails rather than give a region up;
 //  - auto (the default): surfaces, with the local fallback: a region whose face cannot be
-//    built comes back as its facets, sewn to its neighbours, and is reported;
+//    built with exact edges comes back as one face on its surface bounded by the mesh edges of
+//    its border, or where even that fails as its facets, sewn to its neighbours, and is
+//    reported;
 //  - facets: the paper's method 1, one planar face per facet;
 //  - planar: coplanar neighbours merged into one planar face, bounded by its outer wire and
 //    its inner wires (holes), with collinear boundary vertices removed.
@@ -79,12 +81,15 @@ struct SolidDeviation {
     std::uint64_t faces_without_triangles = 0;
 };
 
-/// A region built from its facets instead of its surface (the local fallback).
+/// A region whose face with exact edges could not be built (the local fallback): it came back
+/// as one face on its surface bounded by the mesh edges of its border (`mesh_edges`; its edges
+/// are chords of the surfaces, within the chordal deflection), or as its facets.
 struct ReverseFallback {
     std::int32_t region = 0;
-    std::uint64_t facets = 0;
-    std::string kind;    ///< the region's surface kind, "none" without one
-    std::string reason;  ///< why its face could not be built
+    std::uint64_t facets = 0;  ///< mesh facets in the region
+    std::string kind;          ///< the region's surface kind, "none" without one
+    std::string reason;        ///< why its exact face could not be built
+    bool mesh_edges = false;
 };
 
 /// What reverse_to_step() built, in numbers.
@@ -104,7 +109,7 @@ struct ReverseReport {
     /// fallbacks, the B-rep's edges by how their curve was made, and its largest tolerance.
     std::optional<SegmentResult> segmentation;
     std::vector<ReverseFallback> fallbacks;
-    std::uint64_t fallback_faces = 0;  ///< planar faces of the fallback regions
+    std::uint64_t fallback_faces = 0;  ///< faces of the fallback regions
     /// Regions whose own face failed and whose facets joined a neighbour's face (slivers that
     /// lie on the neighbour's surface).
     std::uint64_t absorbed_regions = 0;

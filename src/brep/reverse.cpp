@@ -206,6 +206,11 @@ std::size_t regions_near(const Mesh& mesh, const FaceMap<std::int32_t>& labels,
             while (brep.regions[r].absorbed_into >= 0) {
                 r = static_cast<std::size_t>(brep.regions[r].absorbed_into);
             }
+            // A fallback's face bounded by its mesh edges: its facets next time.
+            if (brep.regions[r].mesh_edges && !bo.as_facets[r]) {
+                bo.as_facets[r] = 1;
+                ++marked;
+            }
             if (brep.regions[r].fallback || !facets_only[r].empty()) continue;
             const bool plane =
                 surfaces[r].has_surface && surfaces[r].surface.kind == FitKind::kPlane;
@@ -338,6 +343,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     // kReadBackRetries times before the whole part goes planar.
     bo.facets_only.assign(surfaces.size(), std::string());
     bo.plain_corners.assign(surfaces.size(), 0);
+    bo.as_facets.assign(surfaces.size(), 0);
     // The last resort, so that a closed mesh always gives a valid closed solid: the whole part
     // as planar faces (that construction cannot fail), reported as one fallback.
     const auto whole_planar = [&](ReverseReport base,
@@ -392,12 +398,13 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             } else if (b.fallback) {
                 ReverseFallback fb;
                 fb.region = static_cast<std::int32_t>(origin[r]);
-                fb.facets = b.faces.size();
+                fb.facets = b.facets;
                 fb.kind = g.fit.ok ? to_string(g.fit.surface.kind) : "none";
                 fb.reason = b.reason;
+                fb.mesh_edges = b.mesh_edges;
                 rep.fallback_faces += b.faces.size();
+                rep.faces_by_kind[b.mesh_edges ? fb.kind : "facet"] += b.faces.size();
                 rep.fallbacks.push_back(std::move(fb));
-                rep.faces_by_kind["facet"] += b.faces.size();
             } else if (!b.faces.empty()) {
                 rep.faces_by_kind[to_string(g.fit.surface.kind)] += b.faces.size();
             }
@@ -430,8 +437,11 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         }
         for (const ReverseFallback& fb : rep.fallbacks) {
             rep.warnings.push_back("region " + std::to_string(fb.region) + " (" + fb.kind + ", " +
-                                   std::to_string(fb.facets) +
-                                   " facets) built from its facets: " + fb.reason);
+                                   std::to_string(fb.facets) + " facets) built " +
+                                   (fb.mesh_edges
+                                        ? "as one face on its surface bounded by its mesh edges: "
+                                        : "from its facets: ") +
+                                   fb.reason);
         }
         rep.segmentation = sr;
         if (!rep.valid && options.method == ReverseMethod::kAuto) {
@@ -468,7 +478,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                                      rep.segmentation->regions[origin[r]].fit.surface.kind));
                     // Fallback facets take the shape's color (set above): thousands of colored
                     // sub-shapes would cost more than the rest of the STEP.
-                    if (b.fallback && t < 0) continue;
+                    if (b.fallback && !b.mesh_edges && t < 0) continue;
                     for (const TopoDS_Face& f : b.faces) w.face_colors.emplace_back(f, rgb);
                 }
             }

@@ -882,6 +882,24 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         absorbed[r] = best;
         return true;
     };
+    // A fallback region that is not built from its facets: one face on its surface bounded by
+    // the polyline edges of its border (every chain around it is its mesh edges). Its surface,
+    // when it fell back before it had one made.
+    std::vector<std::uint8_t> as_facets(nr, 0);
+    for (std::size_t r = 0; r < nr && r < opt.as_facets.size(); ++r)
+        as_facets[r] = opt.as_facets[r];
+    const auto fallback_surface = [&](std::size_t r) {
+        if (!geom[r].IsNull()) return true;
+        if (!regions[r].has_surface || bd.loops[r].empty()) return false;
+        std::string why;
+        try {
+            geom[r] = geom_surface(regions[r].surface, bd.shapes[r], why);
+            if (!geom[r].IsNull()) sense[r] = natural_sense(geom[r], m, bd.shapes[r]);
+        } catch (const Standard_Failure&) {
+            geom[r].Nullify();
+        }
+        return !geom[r].IsNull();
+    };
     // After absorbing: borders, loops and the neighbours' geometry again.
     const auto relabelled = [&] {
         bd.prepare();
@@ -1194,8 +1212,27 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         Handle(ShapeBuild_ReShape) context = new ShapeBuild_ReShape;
         std::vector<std::vector<TopoDS_Face>> faces(nr);
         std::vector<std::pair<std::size_t, std::string>> failed_region;
+        // A surface face that fails is retried or falls back (below); a fallback region's face
+        // bounded by its mesh edges that fails leaves the region as its facets.
+        const auto face_failed = [&](std::size_t r, std::string why) {
+            if (fallback[r]) {
+                as_facets[r] = 1;
+            } else {
+                failed_region.emplace_back(r, std::move(why));
+            }
+        };
+        // The fallback regions' faces bounded by mesh edges, but not in the last two rounds:
+        // facets always close the shell, so the last round cannot fail on such a face.
+        const bool mesh_edge_faces = opt.allow_fallback && round < kMaxRounds - 1;
         for (std::size_t r = 0; r < nr; ++r) {
-            if (fallback[r] || bd.facets[r] == 0) continue;
+            if (bd.facets[r] == 0) continue;
+            if (fallback[r]) {
+                if (!mesh_edge_faces) as_facets[r] = 1;
+                if (as_facets[r] || !fallback_surface(r)) {
+                    as_facets[r] = 1;
+                    continue;
+                }
+            }
             try {
                 TopoDS_Face F;
                 if (bd.loops[r].empty()) {
@@ -1261,15 +1298,14 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 }
                 if (sense[r] < 0) F.Reverse();
                 if (std::string why = check_failure(F); !why.empty()) {
-                    failed_region.emplace_back(r,
-                                               "its face fails OpenCASCADE's check (" + why + ")");
+                    face_failed(r, "its face fails OpenCASCADE's check (" + why + ")");
                     continue;
                 }
                 if (opt.mesh_deflection > 0) {
                     BRepMesh_IncrementalMesh(F, opt.mesh_deflection, false, 0.2, false);
                     TopLoc_Location loc;
                     if (BRep_Tool::Triangulation(F, loc).IsNull()) {
-                        failed_region.emplace_back(r, std::string(kUntriangulated));
+                        face_failed(r, std::string(kUntriangulated));
                         continue;
                     }
                     // Not kept: neighbours' fixes may still replace its edges, which would
@@ -1278,15 +1314,15 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 }
                 faces[r].push_back(F);
             } catch (const Standard_Failure& f) {
-                failed_region.emplace_back(
+                face_failed(
                     r, std::string("OpenCASCADE fails building its face: ") + f.GetMessageString());
             }
         }
-        // Facet faces of the fallback regions.
+        // Facet faces of the fallback regions without a face of their own.
         for (std::uint32_t fi = 0; fi < m.num_faces(); ++fi) {
             const FaceId f(fi);
             const auto r = static_cast<std::size_t>(labels[f]);
-            if (!fallback[r]) continue;
+            if (!fallback[r] || !as_facets[r]) continue;
             TopoDS_Wire W;
             B.MakeWire(W);
             for (int i = 0; i < 3; ++i) {
@@ -1433,16 +1469,26 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             for (const TopoDS_Shape& f : anc.FindFromIndex(i)) bad_faces.Add(f);
         }
         std::vector<std::size_t> bad_regions;
+        bool to_facets = false;
         for (std::size_t r = 0; r < nr; ++r) {
-            if (fallback[r]) continue;
+            if (fallback[r] && as_facets[r]) continue;
             for (const TopoDS_Face& f : out.regions[r].faces) {
                 if (bad_faces.Contains(f) || bad_faces.Contains(f.Reversed())) {
-                    bad_regions.push_back(r);
+                    // A fallback's face bounded by mesh edges: its facets next round.
+                    if (fallback[r]) {
+                        as_facets[r] = 1;
+                        to_facets = true;
+                    } else {
+                        bad_regions.push_back(r);
+                    }
                     break;
                 }
             }
         }
-        if (bad_regions.empty()) break;
+        if (bad_regions.empty()) {
+            if (to_facets) continue;
+            break;
+        }
         bool plain_retry = false;
         for (std::size_t r : bad_regions) plain_retry = make_plain(r) || plain_retry;
         if (plain_retry && round < kMaxRounds) continue;
@@ -1458,7 +1504,11 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             fall_back(r, "the solid fails OpenCASCADE's check at its face (" + why + ")");
         }
     }
-    for (std::size_t r = 0; r < nr; ++r) out.regions[r].absorbed_into = absorbed[r];
+    for (std::size_t r = 0; r < nr; ++r) {
+        out.regions[r].absorbed_into = absorbed[r];
+        out.regions[r].mesh_edges = fallback[r] && !as_facets[r];
+        out.regions[r].facets = bd.facets[r];
+    }
     // Largest tolerance.
     if (!out.shape.IsNull()) {
         for (TopExp_Explorer x(out.shape, TopAbs_VERTEX); x.More(); x.Next()) {

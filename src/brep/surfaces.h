@@ -40,13 +40,20 @@ struct SurfaceBrepOptions {
     /// Per region (may be empty): its corners are solved without moving them onto the contact
     /// curve of two tangent surfaces (after its face failed with them).
     std::vector<std::uint8_t> plain_corners;
+    /// Per region (may be empty): a fallback region comes back as its facets, not as one face
+    /// on its surface bounded by its mesh edges (that face failed in a STEP written before).
+    std::vector<std::uint8_t> as_facets;
 };
 
 /// What happened to one region.
 struct RegionBuild {
-    bool fallback = false;           ///< built as its facets
+    /// Its face with exact edges could not be built: it is one face on its surface bounded by
+    /// the mesh edges of its border (`mesh_edges`), or its facets.
+    bool fallback = false;
+    bool mesh_edges = false;
     std::string reason;              ///< why, when `fallback`
     std::vector<TopoDS_Face> faces;  ///< the faces it became (one, or its facets)
+    std::size_t facets = 0;          ///< mesh facets in the region
     /// The region whose face took its facets (a sliver whose own face failed and whose facets
     /// are chords of that neighbour's surface); -1 when not absorbed.
     std::int32_t absorbed_into = -1;

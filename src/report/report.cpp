@@ -185,6 +185,7 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
             fallbacks.push_back({{"region", f.region},
                                  {"kind", f.kind},
                                  {"facets", f.facets},
+                                 {"built_as", f.mesh_edges ? "surface, mesh edges" : "facets"},
                                  {"reason", f.reason}});
         }
         r["fallbacks"] = fallbacks;
