@@ -422,6 +422,70 @@ Patch shear_patch(test::Rng& rng, double r, double gamma_deg, double arc_deg, do
     return p;
 }
 
+// A strip a few facets wide of a coarse cylinder or cone, with the vertex normals a mesh gives
+// (its facets' normals averaged): the line that meets the normals is ill-determined there, and
+// the points also lie on other surfaces — two rows of a 36-gon bore (NIST FTC 08) on a thin
+// cylinder across them, a drafted wall's facets from rim to rim (NIST CTC 02, 3 degrees) on a
+// flat cone. The fit must find the true one (or the bore's rows come back one plane each).
+TEST(Fit, NarrowStripsOfCoarseCylindersAndConesFitTheTrueSurface) {
+    // Quads between generator lines at angles k * step about z, each line through (r0, z0)
+    // and (r1, z1), split into two triangles; each vertex has the area-weighted normal of its
+    // triangles and a third of their area as its weight (as segmentation gathers them).
+    struct Strip {
+        std::vector<Vec3> points, normals;
+        std::vector<double> weights;
+    };
+    // `shift` turns the second rim's vertices by that part of a step: a zigzag of triangles
+    // from rim to rim (a tessellator's strip where the rims are divided independently).
+    const auto strip = [](double r0, double z0, double r1, double z1, int lines, double step,
+                          double shift = 0) {
+        Strip s;
+        for (int k = 0; k < lines; ++k) {
+            for (const auto& [r, z, a] :
+                 {std::tuple{r0, z0, k * step}, std::tuple{r1, z1, (k + shift) * step}}) {
+                s.points.push_back({r * std::cos(a), r * std::sin(a), z});
+                s.normals.push_back({0, 0, 0});
+                s.weights.push_back(0);
+            }
+        }
+        const auto triangle = [&s](std::size_t a, std::size_t b, std::size_t c) {
+            Vec3 n = cross(s.points[b] - s.points[a], s.points[c] - s.points[a]);
+            const Vec3 mid = s.points[a] + s.points[b] + s.points[c];
+            if (dot(n, Vec3{mid.x, mid.y, 0}) < 0) n = -n;  // outward
+            for (const std::size_t v : {a, b, c}) {
+                s.normals[v] = s.normals[v] + 0.5 * n;  // area-weighted
+                s.weights[v] += norm(n) / 6;
+            }
+        };
+        for (std::size_t k = 0; k + 1 < static_cast<std::size_t>(lines); ++k) {
+            triangle(2 * k, 2 * k + 2, 2 * k + 3);
+            triangle(2 * k, 2 * k + 3, 2 * k + 1);
+        }
+        for (Vec3& n : s.normals) n = normalized(n);
+        return s;
+    };
+    for (int lines : {3, 4, 6}) {
+        SCOPED_TRACE("cylinder, lines " + std::to_string(lines));
+        const Strip st = strip(7.62, 0, 7.62, 3.43, lines, 10 * kDeg);
+        const FitResult r = fit(FitKind::kCylinder, FitInput{st.points, st.normals, st.weights});
+        ASSERT_TRUE(r.ok) << r.failure;
+        EXPECT_NEAR(r.surface.radius, 7.62, 1e-6);
+        EXPECT_NEAR(std::abs(r.surface.axis.z), 1.0, 1e-9);
+        EXPECT_LT(r.max, 1e-6);
+    }
+    const double draft = 3 * kDeg;
+    for (const auto& [lines, shift] : {std::pair{5, 0.0}, std::pair{7, 0.0}, std::pair{5, 0.5},
+                                       std::pair{6, 0.5}, std::pair{7, 0.5}}) {
+        SCOPED_TRACE("cone, lines " + std::to_string(lines) + " shift " + std::to_string(shift));
+        const Strip st = strip(101, 0, 101 - 40 * std::tan(draft), 40, lines, 11 * kDeg, shift);
+        const FitResult r = fit(FitKind::kCone, FitInput{st.points, st.normals, st.weights});
+        ASSERT_TRUE(r.ok) << r.failure;
+        EXPECT_NEAR(r.surface.angle, draft, 1e-6);
+        EXPECT_NEAR(std::abs(r.surface.axis.z), 1.0, 1e-9);
+        EXPECT_LT(r.max, 1e-6);
+    }
+}
+
 TEST(FitShear, ShearCylindersAndSweptToriFromExactAndNoisyPoints) {
     test::Rng rng(41);
     for (const double gamma : {10.0, 30.0}) {

@@ -11,6 +11,7 @@
 #include <GProp_GProps.hxx>
 #include <Quantity_Color.hxx>
 #include <STEPCAFControl_Reader.hxx>
+#include <ShapeUpgrade_UnifySameDomain.hxx>
 #include <TDF_LabelSequence.hxx>
 #include <TDocStd_Document.hxx>
 #include <TopExp_Explorer.hxx>
@@ -58,6 +59,10 @@ struct Outcome {
     ReverseReport report;
     test::ReadBack back;
     std::size_t true_faces = 0;
+    /// The exact solid's faces once faces of one surface that meet along an edge are one
+    /// (ShapeUpgrade_UnifySameDomain): CAD systems split bores and cones into half faces, a
+    /// split no mesh shows. 0 when the part came without its STEP text.
+    std::size_t unified_faces = 0;
     double true_volume = 0;
     double deflection = 0;  ///< the chordal deflection the mesh was made with
     bool analytic_only = true;
@@ -72,6 +77,15 @@ Outcome reverse_part(const SamplePart& part, bool sre, ReverseMethod method,
                      const std::string& tag) {
     Outcome o;
     o.true_faces = part.faces.size();
+    if (!part.step.empty()) {
+        const auto exact = out_dir() / (tag + ".exact.step");
+        { std::ofstream(exact, std::ios::binary) << part.step; }
+        const test::ReadBack rb = test::read_step(exact);
+        std::filesystem::remove(exact);
+        ShapeUpgrade_UnifySameDomain unify(rb.shape, true, true, false);
+        unify.Build();
+        for (TopExp_Explorer x(unify.Shape(), TopAbs_FACE); x.More(); x.Next()) ++o.unified_faces;
+    }
     o.true_volume = part.solid.volume;
     o.deflection = part.deflection;
     for (const SampleFace& f : part.faces) {
@@ -273,15 +287,15 @@ TEST(ReverseSurfaces, Deterministic) {
 
 SamplePart corpus_part(const std::filesystem::path& path) {
     SampleOptions so;
-    so.with_step = false;
     so.relative_deflection = 1e-3;  // issue 8: tessellated at 1e-3 x the part's size
     Result<SamplePart> made = sample_from_step(path, so);
     EXPECT_TRUE(made.ok()) << path;
     return std::move(made).value();
 }
 
-// Real parts: the MFCAD feature models and NIST CTC 03 come back face for face, NIST FTC 09
-// (158 faces: planes, cylinders, cones) within one face; each a valid closed solid.
+// Real parts: the MFCAD feature models, NIST CTC 03 and FTC 11 come back face for face, NIST
+// FTC 09 (158 faces: planes, cylinders, cones; 125 once its half bores are unified: a mesh
+// shows no such split) within one face of either; each a valid closed solid.
 TEST(ReverseSurfaces, RealPartsFaceForFace) {
     if (corpus_steps().empty()) GTEST_SKIP() << "no corpus at " << corpus_step_dir();
     for (const char* name : {"mfcad_2-3-3-3-3-23.step", "mfcad_4-5-6-13-19.step",
@@ -292,9 +306,13 @@ TEST(ReverseSurfaces, RealPartsFaceForFace) {
         const Outcome o =
             reverse_part(corpus_part(corpus_step_dir() / name), false, ReverseMethod::kAuto, name);
         expect_solid(o, name);
-        EXPECT_LE(std::abs(static_cast<double>(o.report.faces) - static_cast<double>(o.true_faces)),
-                  1.0)
-            << name;
+        // Within one face of the original, or of the original with its split faces unified.
+        const auto off = [&](std::size_t want) {
+            return std::abs(static_cast<double>(o.report.faces) - static_cast<double>(want));
+        };
+        EXPECT_LE(std::min(off(o.true_faces), off(o.unified_faces)), 1.0)
+            << name << ": " << o.report.faces << " faces for " << o.true_faces << " ("
+            << o.unified_faces << " unified)";
         EXPECT_TRUE(o.report.fallbacks.empty()) << name;
         EXPECT_NEAR(o.report.solid_volume, o.true_volume, 1e-3 * o.true_volume) << name;
         ASSERT_TRUE(o.report.deviation.has_value()) << name;
@@ -401,12 +419,16 @@ void print_row(const std::string& name, const char* input, const Outcome& o) {
         if (stage == "brep") brep += s;
         if (stage == "step") step += s;
     }
+    std::string truth = std::to_string(o.true_faces);
+    if (o.unified_faces != 0 && o.unified_faces != o.true_faces) {
+        truth += " (" + std::to_string(o.unified_faces) + ")";
+    }
     std::printf(
-        "| %s | %s | %llu | %s | %zu | %llu | %s | %s | %+.4f %% | %.3f | %s | %s | %.2f / "
+        "| %s | %s | %llu | %s | %s | %llu | %s | %s | %+.4f %% | %.3f | %s | %s | %.2f / "
         "%.2f / %.2f | %.2f |\n",
         name.c_str(), input,
         static_cast<unsigned long long>(r.segmentation ? r.segmentation->region.size() : 0),
-        r.solid && r.valid && o.back.valid ? "yes" : "**no**", o.true_faces,
+        r.solid && r.valid && o.back.valid ? "yes" : "**no**", truth.c_str(),
         static_cast<unsigned long long>(r.faces), kinds.c_str(), fallbacks.c_str(),
         o.true_volume > 0 ? 100 * (r.solid_volume - o.true_volume) / o.true_volume : 0.0,
         o.deflection, dev1.c_str(), dev2.c_str(), seg, brep, step, o.seconds);
@@ -415,7 +437,8 @@ void print_row(const std::string& name, const char* input, const Outcome& o) {
 
 void print_header() {
     std::printf(
-        "| part | input | facets | valid closed solid | true faces | faces | kinds | fallbacks | "
+        "| part | input | facets | valid closed solid | true faces (unified) | faces | kinds | "
+        "fallbacks | "
         "volume vs true | chordal deflection | max dev mesh→solid / δ | max dev solid→mesh / "
         "δ | segment / brep / step s | total s |\n"
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
@@ -441,7 +464,6 @@ TEST(ReverseStudy, DISABLED_Corpus) {
     for (const auto& path : corpus_steps()) {
         if (only && path.filename().string().find(only) == std::string::npos) continue;
         SampleOptions so;
-        so.with_step = false;
         so.relative_deflection = 1e-3;
         if (const char* d = std::getenv("DEFLECTION")) so.deflection = std::atof(d);  // mm
         if (const char* a = std::getenv("ANGULAR")) so.angular_deflection = std::atof(a);

@@ -731,6 +731,11 @@ FitResult fit_sphere(const FitInput& in) {
     return finish(m, it, in);
 }
 
+/// A fit whose normals make more than 60 degrees on average with the given normals (mean |cos|
+/// below this) went to another surface through the same points; the given normals (facet
+/// normals averaged at the vertices) are off the true ones by half a facet's turn at most.
+constexpr double kMinNormalAgreement = 0.5;
+
 /// The line that best meets every normal line (see the top of the file): unit direction and
 /// the point of the line nearest to `origin`. False when the normals leave it undetermined.
 bool axis_from_normals(const FitInput& in, Vec3 origin, Vec3& point, Vec3& dir) {
@@ -778,6 +783,67 @@ void meridian(Vec3 p, Vec3 c, Vec3 d, double& h, double& rho) {
     rho = norm(q - h * d);
 }
 
+/// How well a fitted surface's normals agree with the given ones: the weighted mean |cos| of
+/// the angle between them at the points (1 without normals).
+double normal_agreement(const Surface& s, const FitInput& in) {
+    if (in.normals.size() != in.points.size()) return 1;
+    double sum = 0, total = 0;
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        sum += weight(in, i) * std::abs(dot(normal_at(s, in.points[i]), in.normals[i]));
+        total += weight(in, i);
+    }
+    return total > 0 ? sum / total : 1;
+}
+
+/// Of two fits of one kind from different starts: a is better than b when b failed, or when
+/// only a's normals agree with the given ones (kMinNormalAgreement: b went to another surface
+/// through the same points), or, both or neither agreeing, when a is closer to the points.
+bool better_fit(const FitResult& a, const FitResult& b, const FitInput& in) {
+    if (!a.ok || !b.ok) return a.ok && !b.ok;
+    const bool agree_a = normal_agreement(a.surface, in) >= kMinNormalAgreement;
+    const bool agree_b = normal_agreement(b.surface, in) >= kMinNormalAgreement;
+    if (agree_a != agree_b) return agree_a;
+    return a.max < b.max;
+}
+
+/// The direction the given normals are most nearly all normal to (the least eigenvector of
+/// the sum of n n^T): a cylinder's axis, a cone's generator. False without normals.
+bool normals_normal(const FitInput& in, Vec3& e) {
+    if (in.normals.size() != in.points.size() || in.normals.empty()) return false;
+    Eigen::Matrix3d nn = Eigen::Matrix3d::Zero();
+    for (std::size_t i = 0; i < in.normals.size(); ++i) {
+        const Eigen::Vector3d n(in.normals[i].x, in.normals[i].y, in.normals[i].z);
+        nn += weight(in, i) * n * n.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(nn);
+    if (es.info() != Eigen::Success) return false;
+    const Eigen::Vector3d v = es.eigenvectors().col(0);
+    e = normalized(Vec3{v(0), v(1), v(2)});
+    return finite(e);
+}
+
+/// The cylinder along unit d through the points: its radius and axis point from the circle
+/// (Kasa) through the points projected along d. False when they are collinear.
+bool cylinder_along(const FitInput& in, Vec3 d, CylinderModel& m) {
+    Vec3 u, v;
+    frame(d, u, v);
+    const Vec3 g = centroid(in);
+    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        const Vec3 q = in.points[i] - g;
+        const double x = dot(q, u), y = dot(q, v);
+        const Eigen::Vector3d row(x, y, 1.0);
+        ata += weight(in, i) * row * row.transpose();
+        atb -= weight(in, i) * (x * x + y * y) * row;
+    }
+    const Eigen::Vector3d k = ata.ldlt().solve(atb);
+    const double x0 = -0.5 * k(0), y0 = -0.5 * k(1), r2 = x0 * x0 + y0 * y0 - k(2);
+    if (!k.allFinite() || !(r2 > 0)) return false;
+    m = CylinderModel{Axis::make(g + x0 * u + y0 * v, d), std::sqrt(r2)};
+    return true;
+}
+
 FitResult fit_cylinder(const FitInput& in) {
     Vec3 c, d;
     if (!axis_from_normals(in, centroid(in), c, d)) {
@@ -795,17 +861,24 @@ FitResult fit_cylinder(const FitInput& in) {
     c += dot(g - c, d) * d;
     CylinderModel m{Axis::make(c, d), sum / total};
     const int it = refine(m, in);
-    return finish(m, it, in);
+    FitResult res = finish(m, it, in);
+    // A narrow strip (two rows of a coarse bore, their normals 20 degrees apart) leaves the
+    // line that meets the normals ill-determined, and the points also lie on thin cylinders
+    // across the strip, whose normals are far from the given ones: also from the direction
+    // the normals are all normal to, and the better of the two.
+    Vec3 e;
+    CylinderModel m2{};
+    if (!normals_normal(in, e) || !cylinder_along(in, e, m2)) return res;
+    const int it2 = refine(m2, in);
+    FitResult other = finish(m2, it2, in);
+    return better_fit(other, res, in) ? other : res;
 }
 
-FitResult fit_cone(const FitInput& in) {
-    Vec3 c, d;
-    if (!axis_from_normals(in, centroid(in), c, d)) {
-        return failed(FitKind::kCone, "the normals do not determine an axis");
-    }
+/// The cone about the axis through c along unit d: its generator line rho = r + t h by
+/// weighted least squares in the meridian plane, then refined.
+FitResult cone_about(const FitInput& in, Vec3 c, Vec3 d) {
     const Vec3 g = centroid(in);
     c += dot(g - c, d) * d;
-    // The generator line rho = r + t h, by weighted least squares in the meridian plane.
     double sw = 0, sh = 0, sr = 0, shh = 0, shr = 0;
     for (std::size_t i = 0; i < in.points.size(); ++i) {
         double h, rho;
@@ -837,6 +910,23 @@ FitResult fit_cone(const FitInput& in) {
         res.failure = "the points lie across the apex";
     }
     return res;
+}
+
+FitResult fit_cone(const FitInput& in) {
+    Vec3 c, d;
+    if (!axis_from_normals(in, centroid(in), c, d)) {
+        return failed(FitKind::kCone, "the normals do not determine an axis");
+    }
+    FitResult res = cone_about(in, c, d);
+    // As for the cylinder: a narrow strip of a cone of small half-angle (a drafted wall's
+    // facets, each from rim to rim) leaves the normals' line ill-determined, and the fit can
+    // settle on a flat cone 3 mm off. Its generators are what the normals are all normal to,
+    // within the half-angle: a second start for the axis, and the better of the two.
+    Vec3 e;
+    CylinderModel m{};
+    if (!normals_normal(in, e) || !cylinder_along(in, e, m)) return res;
+    FitResult other = cone_about(in, m.a.c, e);
+    return better_fit(other, res, in) ? other : res;
 }
 
 FitResult fit_torus(const FitInput& in) {
