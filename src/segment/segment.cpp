@@ -583,10 +583,14 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
         // allows.
         const std::size_t na = drafts[a].faces.size(), nb = drafts[b].faces.size();
         FitKindSet kinds = kRevolutionFitKinds;
-        if (na >= kDominantRatio * nb || firm_plane(c, drafts[a]))
+        if (na >= kDominantRatio * nb) {
             kinds = fit_kind_bit(drafts[a].surface.kind);
-        if (nb >= kDominantRatio * na || firm_plane(c, drafts[b]))
-            kinds &= fit_kind_bit(drafts[b].surface.kind);
+        } else if (nb >= kDominantRatio * na) {
+            kinds = fit_kind_bit(drafts[b].surface.kind);
+        } else {
+            if (firm_plane(c, drafts[a])) kinds = fit_kind_bit(drafts[a].surface.kind);
+            if (firm_plane(c, drafts[b])) kinds &= fit_kind_bit(drafts[b].surface.kind);
+        }
         auto r = fit_faces(c, faces, kinds);
         if (!r) continue;
         const bool keep_a = drafts[a].faces.size() >= drafts[b].faces.size();
