@@ -104,6 +104,9 @@ struct FitInput {
     std::span<const Vec3> points;
     std::span<const Vec3> normals;
     std::span<const double> weights;
+    /// When positive, the residual the caller accepts: a cylinder or cone fitted within it
+    /// (and agreeing with the normals) is kept without trying the second start (fitting.md).
+    double accept = 0;
 };
 
 /// The outcome of one fit: `ok` false when the points do not determine the surface (too few,

@@ -808,7 +808,9 @@ bool better_fit(const FitResult& a, const FitResult& b, const FitInput& in) {
 
 /// The direction the given normals are most nearly all normal to (the least eigenvector of
 /// the sum of n n^T): a cylinder's axis, a cone's generator. False without normals.
-bool normals_normal(const FitInput& in, Vec3& e) {
+/// `spread`: the middle eigenvalue over the trace, how widely the normals turn about e (about
+/// Φ²/12 for normals over an arc of Φ radians, 0.5 all round).
+bool normals_normal(const FitInput& in, Vec3& e, double& spread) {
     if (in.normals.size() != in.points.size() || in.normals.empty()) return false;
     Eigen::Matrix3d nn = Eigen::Matrix3d::Zero();
     for (std::size_t i = 0; i < in.normals.size(); ++i) {
@@ -819,7 +821,31 @@ bool normals_normal(const FitInput& in, Vec3& e) {
     if (es.info() != Eigen::Success) return false;
     const Eigen::Vector3d v = es.eigenvectors().col(0);
     e = normalized(Vec3{v(0), v(1), v(2)});
+    const double trace = nn.trace();
+    spread = trace > 0 ? es.eigenvalues()(1) / trace : 0;
     return finite(e);
+}
+
+/// Normals turning over a wide arc (spread from normals_normal()) determine the line they
+/// meet: a first fit that agrees with them needs no second start. 0.2 is an arc of about 90
+/// degrees; a strip of a few facet rows spans 10-40.
+constexpr double kWideNormals = 0.2;
+/// Nor does one within this part of the points' extent of every point: the wrong surfaces
+/// through a strip miss some points by a good part of its width (0.07 and 0.14 of it on the
+/// strips of the test), or pass through all of them with normals across the given ones.
+constexpr double kCloseFit = 1e-3;
+
+/// The first start's fit stands (no second start): it agrees with the normals, and they turn
+/// widely or it passes within the caller's `accept` or kCloseFit of the extent of every point.
+bool first_fit_stands(const FitResult& res, double spread, const FitInput& in) {
+    if (!res.ok || normal_agreement(res.surface, in) < kMinNormalAgreement) return false;
+    if (spread >= kWideNormals || res.max <= in.accept) return true;
+    Vec3 lo = in.points.front(), hi = lo;
+    for (const Vec3& p : in.points) {
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    return res.max <= kCloseFit * norm(hi - lo);
 }
 
 /// The cylinder along unit d through the points: its radius and axis point from the circle
@@ -867,8 +893,10 @@ FitResult fit_cylinder(const FitInput& in) {
     // across the strip, whose normals are far from the given ones: also from the direction
     // the normals are all normal to, and the better of the two.
     Vec3 e;
+    double spread = 0;
     CylinderModel m2{};
-    if (!normals_normal(in, e) || !cylinder_along(in, e, m2)) return res;
+    if (!normals_normal(in, e, spread) || first_fit_stands(res, spread, in)) return res;
+    if (!cylinder_along(in, e, m2)) return res;
     const int it2 = refine(m2, in);
     FitResult other = finish(m2, it2, in);
     return better_fit(other, res, in) ? other : res;
@@ -923,8 +951,10 @@ FitResult fit_cone(const FitInput& in) {
     // settle on a flat cone 3 mm off. Its generators are what the normals are all normal to,
     // within the half-angle: a second start for the axis, and the better of the two.
     Vec3 e;
+    double spread = 0;
     CylinderModel m{};
-    if (!normals_normal(in, e) || !cylinder_along(in, e, m)) return res;
+    if (!normals_normal(in, e, spread) || first_fit_stands(res, spread, in)) return res;
+    if (!cylinder_along(in, e, m)) return res;
     FitResult other = cone_about(in, m.a.c, e);
     return better_fit(other, res, in) ? other : res;
 }

@@ -297,7 +297,9 @@ std::optional<FitResult> fit_faces(Context& c, std::span<const std::uint32_t> fa
         const FitKind kind = order[i];
         if ((kinds & fit_kind_bit(kind)) == 0) continue;
         if (ps.points.size() < kMinVertices[static_cast<int>(kind)]) continue;
-        FitResult r = fit(kind, ps.input());
+        FitInput in = ps.input();
+        in.accept = c.tol;
+        FitResult r = fit(kind, in);
         if (!r.ok || r.max > c.tol) continue;
         if (chords_agree(c, r.surface, faces)) return r;
     }
