@@ -870,6 +870,14 @@ bool cylinder_along(const FitInput& in, Vec3 d, CylinderModel& m) {
     return true;
 }
 
+/// The start of a second fit where the first does not stand (first_fit_stands()): e, the
+/// direction the normals are all normal to, and the cylinder along it. False: keep the first.
+bool second_start(const FitInput& in, const FitResult& first, Vec3& e, CylinderModel& m) {
+    double spread = 0;
+    if (!normals_normal(in, e, spread) || first_fit_stands(first, spread, in)) return false;
+    return cylinder_along(in, e, m);
+}
+
 FitResult fit_cylinder(const FitInput& in) {
     Vec3 c, d;
     if (!axis_from_normals(in, centroid(in), c, d)) {
@@ -893,10 +901,8 @@ FitResult fit_cylinder(const FitInput& in) {
     // across the strip, whose normals are far from the given ones: also from the direction
     // the normals are all normal to, and the better of the two.
     Vec3 e;
-    double spread = 0;
     CylinderModel m2{};
-    if (!normals_normal(in, e, spread) || first_fit_stands(res, spread, in)) return res;
-    if (!cylinder_along(in, e, m2)) return res;
+    if (!second_start(in, res, e, m2)) return res;
     const int it2 = refine(m2, in);
     FitResult other = finish(m2, it2, in);
     return better_fit(other, res, in) ? other : res;
@@ -951,10 +957,8 @@ FitResult fit_cone(const FitInput& in) {
     // settle on a flat cone 3 mm off. Its generators are what the normals are all normal to,
     // within the half-angle: a second start for the axis, and the better of the two.
     Vec3 e;
-    double spread = 0;
     CylinderModel m{};
-    if (!normals_normal(in, e, spread) || first_fit_stands(res, spread, in)) return res;
-    if (!cylinder_along(in, e, m)) return res;
+    if (!second_start(in, res, e, m)) return res;
     FitResult other = cone_about(in, m.a.c, e);
     return better_fit(other, res, in) ? other : res;
 }
