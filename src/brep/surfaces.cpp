@@ -1226,12 +1226,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         const bool mesh_edge_faces = opt.allow_fallback && round < kMaxRounds - 1;
         for (std::size_t r = 0; r < nr; ++r) {
             if (bd.facets[r] == 0) continue;
-            if (fallback[r]) {
-                if (!mesh_edge_faces) as_facets[r] = 1;
-                if (as_facets[r] || !fallback_surface(r)) {
-                    as_facets[r] = 1;
-                    continue;
-                }
+            if (fallback[r] && (!mesh_edge_faces || as_facets[r] || !fallback_surface(r))) {
+                as_facets[r] = 1;
+                continue;
             }
             try {
                 TopoDS_Face F;

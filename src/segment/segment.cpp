@@ -293,12 +293,12 @@ std::optional<FitResult> fit_faces(Context& c, std::span<const std::uint32_t> fa
     if (first) order[n++] = *first;
     for (const FitKind kind : kKindOrder)
         if (!first || kind != *first) order[n++] = kind;
+    FitInput in = ps.input();
+    in.accept = c.tol;
     for (std::size_t i = 0; i < n; ++i) {
         const FitKind kind = order[i];
         if ((kinds & fit_kind_bit(kind)) == 0) continue;
         if (ps.points.size() < kMinVertices[static_cast<int>(kind)]) continue;
-        FitInput in = ps.input();
-        in.accept = c.tol;
         FitResult r = fit(kind, in);
         if (!r.ok || r.max > c.tol) continue;
         if (chords_agree(c, r.surface, faces)) return r;
@@ -580,9 +580,10 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
         if (!drafts[a].alive || !drafts[b].alive || version[a] != va || version[b] != vb) continue;
         std::vector<std::uint32_t> faces = drafts[a].faces;
         faces.insert(faces.end(), drafts[b].faces.begin(), drafts[b].faces.end());
-        // A much larger region keeps its kind, and so does a firm plane: a plane does not
-        // become a torus of large radius to take in the fillet beside it, which the tolerance
-        // allows.
+        // A much larger region keeps its kind (and may take a firm plane that is its chords: a
+        // coarse cone's strip between two generators is exactly planar). Between regions of
+        // like size a firm plane keeps its kind: a plane does not become a torus of large
+        // radius to take in the fillet beside it, which the tolerance allows.
         const std::size_t na = drafts[a].faces.size(), nb = drafts[b].faces.size();
         FitKindSet kinds = kRevolutionFitKinds;
         if (na >= kDominantRatio * nb) {
