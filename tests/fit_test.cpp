@@ -595,7 +595,7 @@ TEST(FitBSpline, PlanesStayPlanesAndNonHeightFieldsFail) {
     const KindSelection s =
         fit_simplest(FitInput{plane.points, plane.normals, {}}, 1e-6 * plane.size);
     EXPECT_EQ(s.best.surface.kind, FitKind::kPlane);
-    // A whole cylinder is no height field over any plane.
+    // A whole cylinder is no height field over any plane, nor an open profile extruded.
     const Patch tube = cylinder_patch(rng, 5, 360, 20, 4000);
     const FitResult r = fit_bspline(FitInput{tube.points, tube.normals, {}}, 1e-3 * tube.size);
     EXPECT_FALSE(r.ok);
@@ -608,6 +608,58 @@ TEST(FitBSpline, PlanesStayPlanesAndNonHeightFieldsFail) {
     EXPECT_FALSE(below.ok);
     ASSERT_TRUE(below.surface.bspline);
     EXPECT_EQ(below.surface.bspline->num_u * below.surface.bspline->num_v, 64 * 64);
+}
+
+// A pocket wall cut along a spline outline: a lobed profile over 270 degrees (it folds back
+// over its mean plane, so no height field), extruded along a tilted direction, sampled as a
+// mesh samples it — the two rims and a middle row, dense on the bends and sparse between.
+TEST(FitBSpline, ExtrudedWallIsOneProfileExtruded) {
+    const Vec3 e = normalized(Vec3{0.1, -0.2, 1});
+    Vec3 u = normalized(cross(e, Vec3{1, 0, 0}));
+    const Vec3 v = cross(e, u);
+    const auto profile = [](double th) { return 10 + 2 * std::sin(3 * th); };
+    std::vector<Vec3> points, normals;
+    for (int k = 0; k <= 600; ++k) {
+        const double s = static_cast<double>(k) / 600;
+        const double th = 1.5 * std::numbers::pi * (s + 0.08 * std::sin(6 * std::numbers::pi * s));
+        const double r = profile(th), dr = 6 * std::cos(3 * th);
+        const Vec3 radial = std::cos(th) * u + std::sin(th) * v;
+        const Vec3 tangent = dr * radial + r * (-std::sin(th) * u + std::cos(th) * v);
+        const Vec3 n = normalized(cross(tangent, e));
+        for (const double h : {-3.0, 0.5, 4.0}) {
+            if (h == 0.5 && k % 3 != 0) continue;
+            points.push_back(Vec3{5, -2, 7} + r * radial + h * e);
+            normals.push_back(n);
+        }
+    }
+    const double tol = 1e-3 * 24;
+    const FitResult r = fit_bspline(FitInput{points, normals, {}}, tol);
+    ASSERT_TRUE(r.ok) << r.failure;
+    EXPECT_LE(r.max, tol);
+    ASSERT_TRUE(r.surface.bspline);
+    EXPECT_EQ(r.surface.bspline->num_v, 4);  // a profile extruded, not a grid
+    EXPECT_LE(r.surface.bspline->num_u, 64);
+    // Points of the wall between the samples, and off it along its normal.
+    for (int k = 0; k < 50; ++k) {
+        const double th = 1.5 * std::numbers::pi * (0.01 + 0.98 * k / 50.0);
+        const Vec3 radial = std::cos(th) * u + std::sin(th) * v;
+        const Vec3 p = Vec3{5, -2, 7} + profile(th) * radial + 1.7 * e;
+        EXPECT_LE(distance(r.surface, p), 2 * tol) << k;
+    }
+    // The same wall all round is closed: no open profile describes it, and it is no height
+    // field either.
+    std::vector<Vec3> ring, ring_normals;
+    for (int k = 0; k < 720; ++k) {
+        const double th = 2 * std::numbers::pi * k / 720;
+        const Vec3 radial = std::cos(th) * u + std::sin(th) * v;
+        const double rr = profile(th), dr = 6 * std::cos(3 * th);
+        const Vec3 tangent = dr * radial + rr * (-std::sin(th) * u + std::cos(th) * v);
+        for (const double h : {-3.0, 4.0}) {
+            ring.push_back(rr * radial + h * e);
+            ring_normals.push_back(normalized(cross(tangent, e)));
+        }
+    }
+    EXPECT_FALSE(fit_bspline(FitInput{ring, ring_normals, {}}, tol).ok);
 }
 
 TEST(FitSnap, NearlyRoundValuesBecomeRoundAndTrueOnesStay) {

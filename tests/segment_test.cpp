@@ -482,6 +482,48 @@ TEST(Segment, FindsTheFacesOfPrismaticCorpusParts) {
     std::filesystem::remove(bogus);
 }
 
+// trimesh_featuretype's pocket wall is one B-spline face in the file: a 10-pole cubic outline,
+// folding back over its mean plane, extruded 4.8 mm. It was 18 pieces (cylinders of radius
+// 0.3-13 mm, small planes); now at most two extrusions (a flat stretch of the outline, a plane
+// of a tenth of the wall, may part them), and the rest of the part one region per face.
+TEST(Segment, SplineWallOfACorpusPartIsFreeForm) {
+    const auto dir = corpus_step_dir();
+    if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no corpus at " << dir;
+    SampleOptions so;
+    so.with_step = false;
+    so.relative_deflection = 1e-3;
+    Result<SamplePart> made = sample_from_step(dir / "trimesh_featuretype.step", so);
+    ASSERT_TRUE(made.ok()) << made.error().describe();
+    const SamplePart& part = made.value();
+    const Mesh mesh = build_mesh(part.mesh).value().mesh;
+    const SegmentResult r = segment(mesh).value();
+    std::int64_t wall = -1;
+    for (const SampleFace& f : part.faces)
+        if (f.kind == "bspline") wall = f.index;
+    ASSERT_GE(wall, 0);
+    std::map<std::int32_t, std::size_t> regions;  // of the wall's facets
+    std::size_t facets = 0;
+    for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+        if (mesh.cuts()[f] != wall) continue;
+        ++regions[r.region[FaceId(static_cast<std::uint32_t>(f))]];
+        ++facets;
+    }
+    // At most two B-spline regions hold nearly all of it (a facet or two at its edges may
+    // stay with a small plane).
+    std::size_t freeform = 0, covered = 0;
+    for (const auto& [g, n] : regions) {
+        if (r.regions[static_cast<std::size_t>(g)].fit.surface.kind != FitKind::kBSpline) continue;
+        ++freeform;
+        covered += n;
+    }
+    EXPECT_GE(freeform, 1u);
+    EXPECT_LE(freeform, 2u);
+    EXPECT_GE(covered, facets * 9 / 10) << covered << " of " << facets;
+    const std::size_t large = regions.size();
+    // Its other 95 faces are 78 once their split cylinder halves are unified.
+    EXPECT_LE(r.regions.size(), 78 + large) << large << " regions on the wall";
+}
+
 // Real parts: each corpus STEP solid tessellated at 1e-3 of its size (as issue 8 asks), the
 // default method against its faces. docs/segmentation.md, "Real parts":
 //   build/bin/ncrev_tests --gtest_also_run_disabled_tests --gtest_filter='SegmentStudy.*Corpus'

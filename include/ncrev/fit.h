@@ -67,6 +67,9 @@ struct BSplineSurface {
     int degree = 3;
     int num_u = 0, num_v = 0;
     std::vector<Vec3> poles;
+    /// A linear extrusion (fit_bspline()): num_v is 4 and each row across is one pole of a
+    /// planar profile moved along one line, so the surface is exactly linear that way.
+    bool extruded = false;
     Vec3 evaluate(double u, double v) const;
     /// Point and first derivatives.
     void evaluate(double u, double v, Vec3& p, Vec3& du, Vec3& dv) const;
@@ -130,8 +133,12 @@ FitResult residuals(const Surface& surface, const FitInput& input);
 /// to within 1e-4 of the points' extent (see fit_bspline()). Never throws.
 FitResult fit(FitKind kind, const FitInput& input);
 
-/// A cubic B-spline surface over the points' mean plane (they must be a height field over it:
-/// free-form machined regions, a die's cavity, are), by least squares with a small smoothing
+/// A cubic B-spline surface. First as a linear extrusion when the normals are all normal to one
+/// direction (a pocket wall cut along a spline outline, which folds back over its mean plane):
+/// its profile fitted in the plane across, with up to 64 poles, then extruded over the points'
+/// span (`BSplineSurface::extruded`); an open profile only. Otherwise over the points' mean plane
+/// (they must be a height field over it: free-form machined regions, a die's cavity, are), by
+/// least squares with a small smoothing
 /// term that also spans cells without points; the control net starts at 4 x 4 and doubles in
 /// each direction until the max residual is within `tolerance` or the net would have more
 /// poles than a quarter of the points (or 64 x 64). `ok` false when the points are not a

@@ -19,10 +19,15 @@
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <numbers>
+#include <numeric>
+#include <queue>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace ncrev {
@@ -141,6 +146,8 @@ constexpr int kBSplineMaxPoles = 64;
 constexpr double kBSplineSmoothing = 1e-6;
 constexpr double kBSplineDefaultTolerance = 1e-4;
 constexpr int kProjectIterations = 20;
+/// Samples per profile pole of an extrusion's start grid (coarse_start()).
+constexpr int kProfileGrid = 4;
 /// Shear cylinder start: the circle made slightly elliptic, so that the ellipse's turn has a
 /// derivative to follow.
 constexpr double kEllipseSeed = 1e-3;
@@ -1021,12 +1028,17 @@ void project_bspline(const BSplineSurface& b, Vec3 p, double& u, double& v) {
 }
 
 /// The nearest of a coarse grid of parameters: a start for project_bspline().
+/// An extrusion's profile folds (an S-shaped pocket wall): its grid follows the profile at
+/// kProfileGrid samples per pole, along the middle only (the nearest point's place along the
+/// profile does not depend on the height).
 void coarse_start(const BSplineSurface& b, Vec3 p, double& u, double& v) {
     double best = std::numeric_limits<double>::infinity();
     constexpr int kGrid = 16;
-    for (int j = 0; j <= kGrid; ++j) {
-        for (int i = 0; i <= kGrid; ++i) {
-            const double uu = static_cast<double>(i) / kGrid, vv = static_cast<double>(j) / kGrid;
+    const int gu = b.extruded ? kProfileGrid * b.num_u : kGrid, gv = b.extruded ? 0 : kGrid;
+    for (int j = 0; j <= gv; ++j) {
+        for (int i = 0; i <= gu; ++i) {
+            const double uu = static_cast<double>(i) / gu,
+                         vv = gv > 0 ? static_cast<double>(j) / gv : 0.5;
             const Vec3 q = b.evaluate(uu, vv) - p;
             const double d2 = dot(q, q);
             if (d2 < best) best = d2, u = uu, v = vv;
@@ -1198,6 +1210,374 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
     }
     fail.failure = "the least-squares system is singular";
     return fail;
+}
+
+/// Normals this close to all normal to one direction e (the mean squared component along e, the
+/// least eigenvalue of the mean n n^T, below this: about 2.5 degrees) make the points a
+/// candidate for a linear extrusion along e (fit_extrusion()).
+constexpr double kExtrusionNormals = 2e-3;
+/// ...and the normals turn about e far more than they lean along it (the middle eigenvalue
+/// this many times the least): the normals of a shallow dome lean a little every way, and no
+/// direction is the extrusion's.
+constexpr double kExtrusionTurn = 1e-2;
+/// Neighbours per point of the graph along the profile (fit_extrusion()).
+constexpr std::size_t kProfileNeighbours = 6;
+/// Pieces of the neighbour graph that fit_extrusion() joins at most (gaps in the sampling); more
+/// are not one profile.
+constexpr int kProfilePieces = 16;
+/// Nodes of that graph at most (see profile_parameters()): joining its pieces costs up to
+/// kProfilePieces x kProfileNodes^2 distance tests.
+constexpr std::size_t kProfileNodes = 4096;
+/// A profile whose ends are within this many of its longest step of each other, the chord
+/// between them running along the curve, is closed.
+constexpr double kClosedProfile = 2;
+/// Two points are neighbours along a profile when the chord between them makes at most this
+/// cosine with either's normal (60 degrees and more: a mesh's chords along a curve make 80 and
+/// more, BRepMesh's angular deflection of 20 degrees at most turning them by half that).
+constexpr double kChordAcross = 0.5;
+/// Chord points across gaps in the profile's sampling (fit_extrusion()): spacing in the
+/// parameter (a quarter of the finest net's knot span) and weight (a point's is 1).
+constexpr double kFillStep = 1.0 / (4 * kBSplineMaxPoles);
+constexpr double kFillWeight = 0.01;
+/// Projections of the points onto the fitted profile: at most this many rounds of new
+/// parameters and a new fit, while a round lowers the largest residual by kProfileGain.
+constexpr int kProfileRounds = 10;
+constexpr double kProfileGain = 0.05;
+/// A net whose profile misses a point by more than kCoarseNetMiss x the tolerance after
+/// kCoarseNetRounds rounds is given up for the next (finer) one.
+constexpr int kCoarseNetRounds = 3;
+constexpr double kCoarseNetMiss = 2;
+
+/// Parameters along the profile of points projected into a plane (with their normals there):
+/// the distance along the minimum spanning tree of their positions from one end, scaled to
+/// [0, 1] (found by two searches: the point farthest from any is an end). A curve sampled
+/// unevenly — a coarse mesh has points 0.05 mm apart on a bend and 3 mm apart on a flat — is a
+/// path in its spanning tree, where a graph of nearest neighbours falls apart at the gaps. The
+/// tree is built from the kProfileNeighbours nearest of each node (points merged in cells of
+/// the tolerance's width; a grid finds them), its pieces joined by their closest pairs; only
+/// pairs whose chord runs along the curve (kChordAcross) are linked. False when the points
+/// span nothing, it would take more than kProfilePieces joins, or the profile is closed.
+bool profile_parameters(const std::vector<double>& x, const std::vector<double>& y,
+                        const std::vector<double>& ux, const std::vector<double>& uy,
+                        double tolerance, std::vector<double>& s) {
+    const std::size_t n = x.size();
+    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+    for (std::size_t i = 0; i < n; ++i) {
+        x0 = std::min(x0, x[i]), x1 = std::max(x1, x[i]);
+        y0 = std::min(y0, y[i]), y1 = std::max(y1, y[i]);
+    }
+    const double span = std::max(x1 - x0, y1 - y0);
+    if (!(span > 0)) return false;
+    // Nodes: the points within one cell of a grid of the tolerance's width, at their mean (the
+    // points of an extrusion's rims and rows coincide here, or nearly: a graph of their nearest
+    // neighbours would link each cluster only within itself).
+    // At most kProfileNodes nodes (the cells grow until so): they only order the points, and
+    // joining the pieces of the graph tests pairs of them.
+    std::vector<std::uint32_t> node(n);
+    std::vector<double> nx, ny, count, mx, my;
+    for (double snap = std::max(tolerance, span * 1e-6);; snap *= 2) {
+        std::map<std::pair<long, long>, std::uint32_t> cells;
+        nx.clear(), ny.clear(), count.clear(), mx.clear(), my.clear();
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::pair<long, long> k{static_cast<long>(std::floor((x[i] - x0) / snap)),
+                                          static_cast<long>(std::floor((y[i] - y0) / snap))};
+            const auto [it, fresh] = cells.emplace(k, static_cast<std::uint32_t>(nx.size()));
+            if (fresh)
+                nx.push_back(0), ny.push_back(0), count.push_back(0), mx.push_back(0),
+                    my.push_back(0);
+            node[i] = it->second;
+            nx[it->second] += x[i], ny[it->second] += y[i], count[it->second] += 1;
+            mx[it->second] += ux[i], my[it->second] += uy[i];
+        }
+        if (nx.size() <= kProfileNodes) break;
+    }
+    const std::size_t m = nx.size();
+    for (std::size_t k = 0; k < m; ++k) {
+        nx[k] /= count[k], ny[k] /= count[k];
+        const double l = std::hypot(mx[k], my[k]);
+        if (l > 0) mx[k] /= l, my[k] /= l;
+    }
+    if (m < 2) return false;
+    // Neighbours along the profile: the chord between them runs along the curve, across both
+    // their normals. Across a fold of the profile (an S-shaped wall's two branches, nearer each
+    // other than the next points along a sparse stretch) it runs along them.
+    const auto along = [&](std::uint32_t a, std::uint32_t b) {
+        const double cx = nx[b] - nx[a], cy = ny[b] - ny[a], l = std::hypot(cx, cy);
+        if (!(l > 0)) return true;
+        return std::fabs(cx * mx[a] + cy * my[a]) <= kChordAcross * l &&
+               std::fabs(cx * mx[b] + cy * my[b]) <= kChordAcross * l;
+    };
+    const double cell = span / std::max(1.0, static_cast<double>(m) / 4);
+    const auto key = [&](double a, double b) {
+        return std::pair<long, long>{static_cast<long>(std::floor((a - x0) / cell)),
+                                     static_cast<long>(std::floor((b - y0) / cell))};
+    };
+    std::map<std::pair<long, long>, std::vector<std::uint32_t>> grid;
+    for (std::uint32_t i = 0; i < m; ++i) grid[key(nx[i], ny[i])].push_back(i);
+    const auto dist = [&](std::uint32_t a, std::uint32_t b) {
+        return std::hypot(nx[a] - nx[b], ny[a] - ny[b]);
+    };
+    using Edge = std::tuple<double, std::uint32_t, std::uint32_t>;
+    std::vector<Edge> edges;
+    for (std::uint32_t i = 0; i < m; ++i) {
+        const auto [cx, cy] = key(nx[i], ny[i]);
+        std::vector<std::pair<double, std::uint32_t>> near;
+        for (long ring = 1; near.size() < kProfileNeighbours && ring <= 8; ring *= 2) {
+            near.clear();
+            for (long gx = cx - ring; gx <= cx + ring; ++gx)
+                for (long gy = cy - ring; gy <= cy + ring; ++gy) {
+                    const auto it = grid.find({gx, gy});
+                    if (it == grid.end()) continue;
+                    for (const std::uint32_t j : it->second)
+                        if (j != i && along(i, j)) near.emplace_back(dist(i, j), j);
+                }
+        }
+        const std::size_t k = std::min<std::size_t>(kProfileNeighbours, near.size());
+        std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(k), near.end());
+        for (std::size_t a = 0; a < k; ++a)
+            edges.emplace_back(near[a].first, std::min(i, near[a].second),
+                               std::max(i, near[a].second));
+    }
+    std::sort(edges.begin(), edges.end());
+    std::vector<std::uint32_t> parent(m);
+    std::iota(parent.begin(), parent.end(), 0u);
+    const auto find = [&](std::uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    std::vector<std::vector<std::pair<std::uint32_t, double>>> tree(m);
+    std::size_t pieces = m;
+    const auto join = [&](std::uint32_t a, std::uint32_t b, double w) {
+        tree[a].emplace_back(b, w);
+        tree[b].emplace_back(a, w);
+        parent[find(a)] = find(b);
+        --pieces;
+    };
+    for (const auto& [w, a, b] : edges)
+        if (find(a) != find(b)) join(a, b, w);
+    for (int joins = 0; pieces > 1; ++joins) {
+        if (joins == kProfilePieces) return false;
+        // The piece of node 0 to its closest other point.
+        const std::uint32_t r0 = find(0);
+        double best = std::numeric_limits<double>::infinity();
+        std::uint32_t ba = 0, bb = 0;
+        for (std::uint32_t a = 0; a < m; ++a) {
+            if (find(a) != r0) continue;
+            for (std::uint32_t b = 0; b < m; ++b) {
+                if (find(b) == r0 || !along(a, b)) continue;
+                const double w = dist(a, b);
+                if (w < best) best = w, ba = a, bb = b;
+            }
+        }
+        if (!std::isfinite(best)) return false;
+        join(ba, bb, best);
+    }
+    // Distances along the tree.
+    std::vector<double> d(m);
+    const auto farthest = [&](std::uint32_t from) {
+        std::fill(d.begin(), d.end(), -1.0);
+        std::vector<std::uint32_t> stack{from};
+        d[from] = 0;
+        std::uint32_t far = from;
+        while (!stack.empty()) {
+            const std::uint32_t v = stack.back();
+            stack.pop_back();
+            if (d[v] > d[far]) far = v;
+            for (const auto& [w, len] : tree[v])
+                if (d[w] < 0) d[w] = d[v] + len, stack.push_back(w);
+        }
+        return far;
+    };
+    const std::uint32_t end = farthest(0);
+    const std::uint32_t other = farthest(end);
+    if (!(d[other] > 0)) return false;
+    // A closed profile (a whole bore, a ring wall) is a path too, its ends one step apart along
+    // the curve: no open curve (nor a face without a seam) describes it.
+    double longest = 0;
+    for (const auto& links : tree)
+        for (const auto& link : links) longest = std::max(longest, link.second);
+    if (dist(end, other) <= kClosedProfile * longest && along(end, other)) return false;
+    s.resize(n);
+    for (std::size_t i = 0; i < n; ++i) s[i] = d[node[i]] / d[other];
+    return true;
+}
+
+/// A linear extrusion: the points lie on lines along one direction e through a planar profile
+/// curve — the wall of a pocket whose outline is a spline, as a flat end mill cuts it. Such a wall
+/// folds back over its mean plane (no height field there), but its profile is a curve: a cubic
+/// B-spline fitted in the plane normal to e (parameters from profile_parameters(), then the
+/// points' projections), extruded over the points' span along e. The result is a B-spline
+/// surface of degree 3 with 4 collinear, evenly spaced poles across (so exactly linear that
+/// way). ok false when the normals are not all normal to one direction, the profile is not one
+/// open curve, or no net up to kBSplineMaxPoles poles along it reaches `tolerance`.
+FitResult fit_extrusion(const FitInput& in, double tolerance) {
+    FitResult fail = failed(FitKind::kBSpline, "not a linear extrusion");
+    const std::size_t n = in.points.size();
+    if (in.normals.size() != n || n < 16) return fail;
+    Eigen::Matrix3d nn = Eigen::Matrix3d::Zero();
+    double total = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Eigen::Vector3d v(in.normals[i].x, in.normals[i].y, in.normals[i].z);
+        nn += weight(in, i) * v * v.transpose();
+        total += weight(in, i);
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(nn);
+    if (es.info() != Eigen::Success || !(total > 0) ||
+        !(es.eigenvalues()(0) <= kExtrusionNormals * total) ||
+        !(es.eigenvalues()(0) <= kExtrusionTurn * es.eigenvalues()(1)))
+        return fail;
+    const Eigen::Vector3d ev = es.eigenvectors().col(0);
+    const Vec3 e = normalized(Vec3{ev(0), ev(1), ev(2)});
+    Vec3 e1, e2;
+    frame(e, e1, e2);
+    const Vec3 c = centroid(in);
+    std::vector<double> x(n), y(n), t(n), ux(n), uy(n), s;
+    double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 q = in.points[i] - c;
+        x[i] = dot(q, e1), y[i] = dot(q, e2), t[i] = dot(q, e);
+        ux[i] = dot(in.normals[i], e1), uy[i] = dot(in.normals[i], e2);
+        t0 = std::min(t0, t[i]), t1 = std::max(t1, t[i]);
+    }
+    if (!(t1 > t0) || !profile_parameters(x, y, ux, uy, tolerance, s)) {
+        fail.failure = "the points along the extrusion are not one open profile";
+        return fail;
+    }
+    // Chords across the gaps: a coarse mesh leaves steps of several millimetres along a flat
+    // stretch of the profile, where a knot span may hold no point and the curve would bulge
+    // between its neighbours (2 mm on trimesh_featuretype's wall). Points on the chord between
+    // consecutive points (kFillStep apart in the parameter, weighted kFillWeight) hold it there:
+    // the mesh's own facets are those chords, within its deflection of the surface.
+    {
+        std::vector<std::size_t> by_s(n);
+        std::iota(by_s.begin(), by_s.end(), std::size_t{0});
+        std::sort(by_s.begin(), by_s.end(),
+                  [&](std::size_t a, std::size_t b) { return s[a] != s[b] ? s[a] < s[b] : a < b; });
+        for (std::size_t k = 1; k < n; ++k) {
+            const std::size_t a = by_s[k - 1], b = by_s[k];
+            const auto steps = static_cast<int>((s[b] - s[a]) / kFillStep);
+            for (int j = 1; j < steps; ++j) {
+                const double f = static_cast<double>(j) / steps;
+                x.push_back(x[a] + f * (x[b] - x[a]));
+                y.push_back(y[a] + f * (y[b] - y[a]));
+                s.push_back(s[a] + f * (s[b] - s[a]));
+            }
+        }
+    }
+    const std::size_t all = s.size();
+    const auto w_of = [&](std::size_t i) { return i < n ? weight(in, i) : kFillWeight; };
+    FitResult best = fail;
+    const std::vector<double> s0 = s;
+    for (int np = kBSplineStartPoles; np <= kBSplineMaxPoles; np *= 2) {
+        s = s0;  // each net from the profile's own parameters, not a coarser net's projections
+        Eigen::VectorXd px, py;
+        // The distance of each point from the curve in the plane across (its distance from
+        // the extrusion: every point lies within the extrusion's span), from its projection.
+        std::vector<double> off(n, 0.0);
+        const auto project = [&]() {
+            double worst = 0;
+            for (std::size_t i = 0; i < all; ++i) {
+                double u = s[i], cx = 0, cy = 0;
+                for (int it = 0; it < kProjectIterations; ++it) {
+                    double N[kMaxDegree + 1], dN[kMaxDegree + 1];
+                    const int sp = basis(3, np, u, N, dN) - 3;
+                    double dx = 0, dy = 0;
+                    cx = 0, cy = 0;
+                    for (int a = 0; a <= 3; ++a) {
+                        cx += N[a] * px(sp + a), cy += N[a] * py(sp + a);
+                        dx += dN[a] * px(sp + a), dy += dN[a] * py(sp + a);
+                    }
+                    const double dd = dx * dx + dy * dy;
+                    if (!(dd > 0)) break;
+                    const double nu =
+                        std::clamp(u - ((cx - x[i]) * dx + (cy - y[i]) * dy) / dd, 0.0, 1.0);
+                    const bool done = std::fabs(nu - u) < 1e-13;
+                    u = nu;
+                    if (done) break;
+                }
+                s[i] = u;
+                if (i < n) {
+                    double N[kMaxDegree + 1];
+                    const int sp = basis(3, np, u, N, nullptr) - 3;
+                    cx = 0, cy = 0;
+                    for (int a = 0; a <= 3; ++a) cx += N[a] * px(sp + a), cy += N[a] * py(sp + a);
+                    off[i] = std::hypot(cx - x[i], cy - y[i]);
+                    worst = std::max(worst, off[i]);
+                }
+            }
+            return worst;
+        };
+        double worst = std::numeric_limits<double>::infinity();
+        bool last = false;
+        for (int round = 0;; ++round) {
+            // Least squares for the poles, with the smoothing of fit_bspline_impl().
+            Eigen::MatrixXd A = Eigen::MatrixXd::Zero(np, np);
+            Eigen::VectorXd bx = Eigen::VectorXd::Zero(np), by = Eigen::VectorXd::Zero(np);
+            for (std::size_t i = 0; i < all; ++i) {
+                double N[kMaxDegree + 1];
+                const int sp = basis(3, np, s[i], N, nullptr) - 3;
+                const double w = w_of(i);
+                for (int a = 0; a <= 3; ++a) {
+                    bx(sp + a) += w * N[a] * x[i];
+                    by(sp + a) += w * N[a] * y[i];
+                    for (int b = 0; b <= 3; ++b) A(sp + a, sp + b) += w * N[a] * N[b];
+                }
+            }
+            const double lambda = kBSplineSmoothing * total / np;
+            for (int a = 1; a + 1 < np; ++a) {
+                const int idx[3] = {a - 1, a, a + 1};
+                const double coef[3] = {1, -2, 1};
+                for (int r = 0; r < 3; ++r)
+                    for (int k = 0; k < 3; ++k) A(idx[r], idx[k]) += lambda * coef[r] * coef[k];
+            }
+            const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
+            px = ldlt.solve(bx), py = ldlt.solve(by);
+            if (ldlt.info() != Eigen::Success || !px.allFinite() || !py.allFinite()) return best;
+            // New parameters: each point's projection onto the curve (Newton from its own).
+            const double now = project();
+            if (last) {
+                worst = now;
+                break;
+            }
+            // Another round only while it pays: one that gains less than kProfileGain ends it
+            // (after one more fit). Not at the tolerance: the pieces' own residuals are the
+            // measure merge_freeform() holds the extrusion to.
+            last = round + 1 >= kProfileRounds || now > (1 - kProfileGain) * worst;
+            worst = now;
+            // A net still far off after a few rounds makes way for a finer one.
+            if (round + 1 >= kCoarseNetRounds && now > kCoarseNetMiss * tolerance &&
+                np < kBSplineMaxPoles)
+                break;
+        }
+        if (!(worst <= tolerance) && np < kBSplineMaxPoles) continue;  // a finer net
+        auto bs = std::make_shared<BSplineSurface>();
+        bs->num_u = np, bs->num_v = 4;
+        bs->extruded = true;
+        bs->poles.resize(static_cast<std::size_t>(4 * np));
+        for (int j = 0; j < 4; ++j)
+            for (int a = 0; a < np; ++a)
+                bs->poles[static_cast<std::size_t>(a + np * j)] =
+                    c + px(a) * e1 + py(a) * e2 + (t0 + (t1 - t0) * j / 3.0) * e;
+        double sum = 0, mx = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            sum += weight(in, i) * off[i] * off[i];
+            mx = std::max(mx, off[i]);
+        }
+        FitResult r;
+        r.ok = true;
+        r.surface.kind = FitKind::kBSpline;
+        r.surface.point = c;
+        r.surface.axis = e;
+        r.surface.bspline = bs;
+        r.rms = std::sqrt(sum / total);
+        r.max = mx;
+        r.iterations = 4 * np;
+        if (mx <= tolerance) return r;
+        best = r;
+    }
+    best.ok = false;
+    best.failure = "no profile of up to the size limit of poles reaches the tolerance";
+    return best;
 }
 
 FitResult fit_shear_cylinder(const FitInput& in) {
@@ -1481,6 +1861,9 @@ FitResult fit_bspline(const FitInput& in, double tolerance) {
             return failed(FitKind::kBSpline, "a point or weight is not a finite number");
         }
     }
+    // A wall extruded along one direction first: its net is a profile's, not a grid's.
+    FitResult extrusion = fit_extrusion(in, tolerance);
+    if (extrusion.ok) return extrusion;
     return fit_bspline_impl(in, tolerance);
 }
 
