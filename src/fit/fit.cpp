@@ -1046,6 +1046,22 @@ void coarse_start(const BSplineSurface& b, Vec3 p, double& u, double& v) {
     }
 }
 
+/// A fitted B-spline: `point` and `axis` its mean plane's (a net's) or its centroid and
+/// direction (an extrusion's); `iterations` its number of poles.
+FitResult bspline_fit(std::shared_ptr<BSplineSurface> bs, Vec3 point, Vec3 axis, double rms,
+                      double max, int iterations) {
+    FitResult r;
+    r.ok = true;
+    r.surface.kind = FitKind::kBSpline;
+    r.surface.point = point;
+    r.surface.axis = axis;
+    r.surface.bspline = std::move(bs);
+    r.rms = rms;
+    r.max = max;
+    r.iterations = iterations;
+    return r;
+}
+
 FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
     FitResult fail;
     fail.surface.kind = FitKind::kBSpline;
@@ -1188,15 +1204,7 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
             sum += weight(in, i) * d * d;
             mx = std::max(mx, d);
         }
-        FitResult r;
-        r.ok = true;
-        r.surface.kind = FitKind::kBSpline;
-        r.surface.point = c;
-        r.surface.axis = nrm;
-        r.surface.bspline = bs;
-        r.rms = std::sqrt(sum / total);
-        r.max = mx;
-        r.iterations = nu * nv;
+        FitResult r = bspline_fit(std::move(bs), c, nrm, std::sqrt(sum / total), mx, nu * nv);
         best = r;
         if (mx <= tolerance) return r;
         base *= 2;
@@ -1563,15 +1571,7 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
             sum += weight(in, i) * off[i] * off[i];
             mx = std::max(mx, off[i]);
         }
-        FitResult r;
-        r.ok = true;
-        r.surface.kind = FitKind::kBSpline;
-        r.surface.point = c;
-        r.surface.axis = e;
-        r.surface.bspline = bs;
-        r.rms = std::sqrt(sum / total);
-        r.max = mx;
-        r.iterations = 4 * np;
+        FitResult r = bspline_fit(std::move(bs), c, e, std::sqrt(sum / total), mx, 4 * np);
         if (mx <= tolerance) return r;
         best = r;
     }
