@@ -34,6 +34,7 @@
 #include "ncrev/brep.h"
 #include "ncrev/io.h"
 #include "ncrev/sample.h"
+#include "ncrev/segment.h"
 #include "sample_cases.h"
 #include "step_readback.h"
 
@@ -458,6 +459,43 @@ TEST(ReverseStudy, DISABLED_Samples) {
     }
 }
 
+/// Face for face: the true faces whose facets lie (by area) at least kMatchShare in one region
+/// of the default segmentation, that region's facets at least kMatchShare on that face. Counts
+/// say less: a wall in 18 pieces and 17 split bores unified can add up to the right number.
+struct FaceMatch {
+    std::size_t matched = 0, split = 0, joined = 0;  ///< true faces; regions over several
+};
+constexpr double kMatchShare = 0.9;
+FaceMatch match_faces(const SamplePart& part) {
+    FaceMatch fm;
+    const Result<BuildResult> built = build_mesh(part.mesh);
+    if (!built.ok()) return fm;
+    const Mesh& mesh = built.value().mesh;
+    const Result<SegmentResult> seg = segment(mesh);
+    if (!seg.ok()) return fm;
+    std::map<std::pair<std::int64_t, std::int32_t>, double> both;
+    std::map<std::int64_t, double> face_area;
+    std::map<std::int32_t, double> region_area;
+    for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+        const FaceId ff(static_cast<std::uint32_t>(f));
+        const double a = mesh.face_area(ff);
+        both[{mesh.cuts()[f], seg.value().region[ff]}] += a;
+        face_area[mesh.cuts()[f]] += a;
+        region_area[seg.value().region[ff]] += a;
+    }
+    std::map<std::int64_t, std::size_t> pieces;  // regions holding a tenth of a true face
+    std::map<std::int32_t, std::size_t> faces;   // true faces holding a tenth of a region
+    for (const auto& [key, a] : both) {
+        const auto [t, g] = key;
+        if (a >= (1 - kMatchShare) * face_area[t]) ++pieces[t];
+        if (a >= (1 - kMatchShare) * region_area[g]) ++faces[g];
+        if (a >= kMatchShare * face_area[t] && a >= kMatchShare * region_area[g]) ++fm.matched;
+    }
+    for (const auto& [t, n] : pieces) fm.split += n > 1;
+    for (const auto& [g, n] : faces) fm.joined += n > 1;
+    return fm;
+}
+
 TEST(ReverseStudy, DISABLED_Corpus) {
     print_header();
     const char* only = std::getenv("PART");  // PART=name: that file only
@@ -483,6 +521,11 @@ TEST(ReverseStudy, DISABLED_Corpus) {
         }
         const Outcome o = reverse_part(made.value(), false, ReverseMethod::kAuto, "study");
         print_row(path.filename().string(), "STL", o);
+        const FaceMatch fm = match_faces(made.value());
+        std::printf(
+            "|   face for face: %zu of %zu true faces one region each; %zu true faces in "
+            "several regions, %zu regions over several true faces |\n",
+            fm.matched, o.true_faces, fm.split, fm.joined);
         if (only) {
             for (const ReverseFallback& f : o.report.fallbacks) {
                 std::printf("|   fallback: region %d (%s, %llu facets) as %s: %s |\n", f.region,
