@@ -1244,7 +1244,7 @@ constexpr double kClosedProfile = 2;
 /// more, BRepMesh's angular deflection of 20 degrees at most turning them by half that).
 constexpr double kChordAcross = 0.5;
 /// Chord points across gaps in the profile's sampling (fit_extrusion()): spacing in the
-/// parameter (a quarter of the finest net's knot span) and weight (a point's is 1).
+/// parameter (a quarter of the finest net's knot span) and weight (of the points' mean).
 constexpr double kFillStep = 1.0 / (4 * kBSplineMaxPoles);
 constexpr double kFillWeight = 0.01;
 /// Projections of the points onto the fitted profile: at most this many rounds of new
@@ -1473,7 +1473,8 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
         }
     }
     const std::size_t all = s.size();
-    const auto w_of = [&](std::size_t i) { return i < n ? weight(in, i) : kFillWeight; };
+    const double fill_weight = kFillWeight * total / static_cast<double>(n);
+    const auto w_of = [&](std::size_t i) { return i < n ? weight(in, i) : fill_weight; };
     FitResult best = fail;
     const std::vector<double> s0 = s;
     for (int np = kBSplineStartPoles; np <= kBSplineMaxPoles; np *= 2) {
