@@ -519,9 +519,9 @@ TEST(Segment, SplineWallOfACorpusPartIsFreeForm) {
     EXPECT_GE(freeform, 1u);
     EXPECT_LE(freeform, 2u);
     EXPECT_GE(covered, facets * 9 / 10) << covered << " of " << facets;
-    const std::size_t large = regions.size();
+    const std::size_t on_wall = regions.size();
     // Its other 95 faces are 78 once their split cylinder halves are unified.
-    EXPECT_LE(r.regions.size(), 78 + large) << large << " regions on the wall";
+    EXPECT_LE(r.regions.size(), 78 + on_wall) << on_wall << " regions on the wall";
 }
 
 // Real parts: each corpus STEP solid tessellated at 1e-3 of its size (as issue 8 asks), the

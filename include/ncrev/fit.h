@@ -138,8 +138,8 @@ FitResult fit(FitKind kind, const FitInput& input);
 /// its profile fitted in the plane across, with up to 64 poles, then extruded over the points'
 /// span (`BSplineSurface::extruded`); an open profile only. Otherwise over the points' mean plane
 /// (they must be a height field over it: free-form machined regions, a die's cavity, are), by
-/// least squares with a small smoothing
-/// term that also spans cells without points; the control net starts at 4 x 4 and doubles in
+/// least squares with a small smoothing term that also spans cells without points; the
+/// control net starts at 4 x 4 and doubles in
 /// each direction until the max residual is within `tolerance` or the net would have more
 /// poles than a quarter of the points (or 64 x 64). `ok` false when the points are not a
 /// height field over their plane or no net reaches the tolerance.

@@ -823,8 +823,9 @@ bool better_fit(const FitResult& a, const FitResult& b, const FitInput& in) {
 /// The direction the given normals are most nearly all normal to (the least eigenvector of
 /// the sum of n n^T): a cylinder's axis, a cone's generator. False without normals.
 /// `spread`: the middle eigenvalue over the trace, how widely the normals turn about e (about
-/// Φ²/12 for normals over an arc of Φ radians, 0.5 all round).
-bool normals_normal(const FitInput& in, Vec3& e, double& spread) {
+/// Φ²/12 for normals over an arc of Φ radians, 0.5 all round); `lean`, when asked for: the least
+/// over the trace, how far they lean along e (the mean squared cosine).
+bool normals_normal(const FitInput& in, Vec3& e, double& spread, double* lean = nullptr) {
     if (in.normals.size() != in.points.size() || in.normals.empty()) return false;
     Eigen::Matrix3d nn = Eigen::Matrix3d::Zero();
     for (std::size_t i = 0; i < in.normals.size(); ++i) {
@@ -837,6 +838,7 @@ bool normals_normal(const FitInput& in, Vec3& e, double& spread) {
     e = normalized(Vec3{v(0), v(1), v(2)});
     const double trace = nn.trace();
     spread = trace > 0 ? es.eigenvalues()(1) / trace : 0;
+    if (lean) *lean = trace > 0 ? es.eigenvalues()(0) / trace : 1;
     return finite(e);
 }
 
@@ -1220,13 +1222,13 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
     return fail;
 }
 
-/// Normals this close to all normal to one direction e (the mean squared component along e, the
-/// least eigenvalue of the mean n n^T, below this: about 2.5 degrees) make the points a
+/// Normals this close to all normal to one direction e (their lean along it from
+/// normals_normal(), the mean squared cosine, below this: about 2.5 degrees) make the points a
 /// candidate for a linear extrusion along e (fit_extrusion()).
 constexpr double kExtrusionNormals = 2e-3;
-/// ...and the normals turn about e far more than they lean along it (the middle eigenvalue
-/// this many times the least): the normals of a shallow dome lean a little every way, and no
-/// direction is the extrusion's.
+/// ...and the normals turn about e far more than they lean along it (the lean at most this part
+/// of the spread): the normals of a shallow dome lean a little every way, and no direction is
+/// the extrusion's.
 constexpr double kExtrusionTurn = 1e-2;
 /// Neighbours per point of the graph along the profile (fit_extrusion()).
 constexpr std::size_t kProfileNeighbours = 6;
@@ -1422,23 +1424,15 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
     FitResult fail = failed(FitKind::kBSpline, "not a linear extrusion");
     const std::size_t n = in.points.size();
     if (in.normals.size() != n || n < 16) return fail;
-    Eigen::Matrix3d nn = Eigen::Matrix3d::Zero();
-    double total = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const Eigen::Vector3d v(in.normals[i].x, in.normals[i].y, in.normals[i].z);
-        nn += weight(in, i) * v * v.transpose();
-        total += weight(in, i);
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(nn);
-    if (es.info() != Eigen::Success || !(total > 0) ||
-        !(es.eigenvalues()(0) <= kExtrusionNormals * total) ||
-        !(es.eigenvalues()(0) <= kExtrusionTurn * es.eigenvalues()(1)))
+    Vec3 e;
+    double spread = 0, lean = 1;
+    if (!normals_normal(in, e, spread, &lean) || !(lean <= kExtrusionNormals) ||
+        !(lean <= kExtrusionTurn * spread))
         return fail;
-    const Eigen::Vector3d ev = es.eigenvectors().col(0);
-    const Vec3 e = normalized(Vec3{ev(0), ev(1), ev(2)});
     Vec3 e1, e2;
     frame(e, e1, e2);
-    const Vec3 c = centroid(in);
+    double total = 0;
+    const Vec3 c = centroid(in, &total);
     std::vector<double> x(n), y(n), t(n), ux(n), uy(n), s;
     double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -1483,19 +1477,22 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
         // The distance of each point from the curve in the plane across (its distance from
         // the extrusion: every point lies within the extrusion's span), from its projection.
         std::vector<double> off(n, 0.0);
+        // The profile's point at u and its derivative there.
+        const auto curve = [&](double u, double& cx, double& cy, double& dx, double& dy) {
+            double N[kMaxDegree + 1], dN[kMaxDegree + 1];
+            const int sp = basis(3, np, u, N, dN) - 3;
+            cx = cy = dx = dy = 0;
+            for (int a = 0; a <= 3; ++a) {
+                cx += N[a] * px(sp + a), cy += N[a] * py(sp + a);
+                dx += dN[a] * px(sp + a), dy += dN[a] * py(sp + a);
+            }
+        };
         const auto project = [&]() {
             double worst = 0;
             for (std::size_t i = 0; i < all; ++i) {
-                double u = s[i], cx = 0, cy = 0;
+                double u = s[i], cx = 0, cy = 0, dx = 0, dy = 0;
                 for (int it = 0; it < kProjectIterations; ++it) {
-                    double N[kMaxDegree + 1], dN[kMaxDegree + 1];
-                    const int sp = basis(3, np, u, N, dN) - 3;
-                    double dx = 0, dy = 0;
-                    cx = 0, cy = 0;
-                    for (int a = 0; a <= 3; ++a) {
-                        cx += N[a] * px(sp + a), cy += N[a] * py(sp + a);
-                        dx += dN[a] * px(sp + a), dy += dN[a] * py(sp + a);
-                    }
+                    curve(u, cx, cy, dx, dy);
                     const double dd = dx * dx + dy * dy;
                     if (!(dd > 0)) break;
                     const double nu =
@@ -1506,10 +1503,7 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
                 }
                 s[i] = u;
                 if (i < n) {
-                    double N[kMaxDegree + 1];
-                    const int sp = basis(3, np, u, N, nullptr) - 3;
-                    cx = 0, cy = 0;
-                    for (int a = 0; a <= 3; ++a) cx += N[a] * px(sp + a), cy += N[a] * py(sp + a);
+                    curve(u, cx, cy, dx, dy);
                     off[i] = std::hypot(cx - x[i], cy - y[i]);
                     worst = std::max(worst, off[i]);
                 }

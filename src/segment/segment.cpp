@@ -721,8 +721,8 @@ std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
         // free-form face are few and large, and fewer numbers than its net.)
         // And one that describes the points less closely than its pieces (kFreeformRms x their
         // RMS): a CAD mesh's analytic faces lie on their surfaces to rounding, a free-form
-        // face's pieces only within the tolerance (trimesh_featuretype's spline wall: 0.0097
-        // against 0.0056 mm; a coarse chain of fillets on NIST CTC 01: 0.093 against 0.019).
+        // face's pieces only within the tolerance (without this, NIST CTC 01 and 03 lose a
+        // chain of coarse fillets to one extrusion: Segment.FindsTheFacesOfPrismaticCorpusParts).
         if (r.surface.bspline->extruded) {
             std::size_t pieces = 0;
             double sum = 0, count = 0;
