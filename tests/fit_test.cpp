@@ -662,6 +662,33 @@ TEST(FitBSpline, ExtrudedWallIsOneProfileExtruded) {
     EXPECT_FALSE(fit_bspline(FitInput{ring, ring_normals, {}}, tol).ok);
 }
 
+// A wall along a hairpin profile (a parabola of 0.5 mm vertex radius whose arms run 36 mm):
+// nets spread by length along the profile put a pole or two on the bend and miss it; the start
+// by length and turning puts many there.
+TEST(FitBSpline, ExtrusionFollowsATightBend) {
+    const double radius = 0.25;
+    std::vector<Vec3> points, normals;
+    for (int k = -3000; k <= 3000; ++k) {
+        const double y = 6.0 * k / 3000, x = y * y / (2 * radius);
+        const Vec3 n = normalized(Vec3{1, -y / radius, 0});
+        for (const double z : {0.0, 2.0, 5.0}) {
+            points.push_back(Vec3{x, y, z});
+            normals.push_back(n);
+        }
+    }
+    const double tol = 0.01;
+    const FitResult r = fit_bspline(FitInput{points, normals, {}}, tol);
+    ASSERT_TRUE(r.ok) << r.failure;
+    ASSERT_TRUE(r.surface.bspline);
+    EXPECT_TRUE(r.surface.bspline->extruded);
+    EXPECT_LE(r.max, tol);
+    // On the bend, between the samples.
+    for (int k = -20; k <= 20; ++k) {
+        const double y = 0.05 * k + 0.001, x = y * y / (2 * radius);
+        EXPECT_LE(distance(r.surface, Vec3{x, y, 3.3}), 2 * tol) << y;
+    }
+}
+
 TEST(FitSnap, NearlyRoundValuesBecomeRoundAndTrueOnesStay) {
     // A cylinder of radius 10.02 along z, 0.05 degrees off, with 0.001 mm noise.
     test::Rng rng(21);

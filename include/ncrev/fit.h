@@ -70,6 +70,10 @@ struct BSplineSurface {
     /// A linear extrusion (fit_bspline()): num_v is 4 and each row across is one pole of a
     /// planar profile moved along one line, so the surface is exactly linear that way.
     bool extruded = false;
+    /// The surface at the grid of parameters where projections onto it start (distance(),
+    /// closest_point(), normal_at()), filled by fit_bspline(); evaluated on each call when
+    /// empty. A cache: it must hold the grid's points of these poles.
+    std::vector<Vec3> starts;
     Vec3 evaluate(double u, double v) const;
     /// Point and first derivatives.
     void evaluate(double u, double v, Vec3& p, Vec3& du, Vec3& dv) const;
@@ -110,6 +114,9 @@ struct FitInput {
     /// When positive, the residual the caller accepts: a cylinder or cone fitted within it
     /// (and agreeing with the normals) is kept without trying the second start (fitting.md).
     double accept = 0;
+    /// When positive, a linear extrusion (fit_bspline()) goes on to profiles of more poles
+    /// until its RMS residual is within this too, not only its max within the tolerance.
+    double rms_goal = 0;
 };
 
 /// The outcome of one fit: `ok` false when the points do not determine the surface (too few,
@@ -135,14 +142,15 @@ FitResult fit(FitKind kind, const FitInput& input);
 
 /// A cubic B-spline surface. First as a linear extrusion when the normals are all normal to one
 /// direction (a pocket wall cut along a spline outline, which folds back over its mean plane):
-/// its profile fitted in the plane across, with up to 64 poles, then extruded over the points'
-/// span (`BSplineSurface::extruded`); an open profile only. Otherwise over the points' mean plane
-/// (they must be a height field over it: free-form machined regions, a die's cavity, are), by
-/// least squares with a small smoothing term that also spans cells without points; the
-/// control net starts at 4 x 4 and doubles in
-/// each direction until the max residual is within `tolerance` or the net would have more
-/// poles than a quarter of the points (or 64 x 64). `ok` false when the points are not a
-/// height field over their plane or no net reaches the tolerance.
+/// its profile fitted in the plane across, with up to 64 poles (the fewest that reach the
+/// tolerance and `rms_goal`; each size from two starts, parameters by length along the profile
+/// and by length and turning), then extruded over the points' span (`BSplineSurface::extruded`);
+/// an open profile only. Otherwise over the points' mean plane (they must be a height field over
+/// it: free-form machined regions, a die's cavity, are), by least squares with a small smoothing
+/// term that also spans cells without points; the control net starts at 4 x 4 and grows by half
+/// in each direction until the max residual is within `tolerance` or the net would have more
+/// poles than half the points (or 64 x 64). `ok` false when the points are not a height field
+/// over their plane or no net reaches the tolerance.
 FitResult fit_bspline(const FitInput& input, double tolerance);
 
 /// The simplest kind whose fit keeps every point within `tolerance` (max residual), in the

@@ -25,6 +25,7 @@
 #include <map>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <queue>
 #include <string>
 #include <tuple>
@@ -143,6 +144,11 @@ constexpr double kTorusRunaway = 100.0;
 /// fraction of the points' extent, and the Gauss-Newton steps of a projection.
 constexpr int kBSplineStartPoles = 4;
 constexpr int kBSplineMaxPoles = 64;
+/// Each net (or extrusion's profile) tried has this many times the poles along each direction
+/// of the one before: finer steps than doubling, since poles are free parameters (a net of 272
+/// where one of 156 would do passes the limit of merge_freeform(), which also weighs an
+/// extrusion's poles against its pieces' parameters).
+constexpr double kNetGrowth = 1.5;
 constexpr double kBSplineSmoothing = 1e-6;
 constexpr double kBSplineDefaultTolerance = 1e-4;
 constexpr int kProjectIterations = 20;
@@ -1029,21 +1035,51 @@ void project_bspline(const BSplineSurface& b, Vec3 p, double& u, double& v) {
     }
 }
 
-/// The nearest of a coarse grid of parameters: a start for project_bspline().
-/// An extrusion's profile folds (an S-shaped pocket wall): its grid follows the profile at
+/// The grid of coarse_start(): gu + 1 by gv + 1 parameters (gv 0: the middle only). An
+/// extrusion's profile folds (an S-shaped pocket wall): its grid follows the profile at
 /// kProfileGrid samples per pole, along the middle only (the nearest point's place along the
 /// profile does not depend on the height).
+void start_grid(const BSplineSurface& b, int& gu, int& gv) {
+    constexpr int kGrid = 16;
+    gu = b.extruded ? kProfileGrid * b.num_u : kGrid;
+    gv = b.extruded ? 0 : kGrid;
+}
+
+Vec3 start_point(const BSplineSurface& b, int gu, int gv, int i, int j, double& u, double& v) {
+    u = static_cast<double>(i) / gu;
+    v = gv > 0 ? static_cast<double>(j) / gv : 0.5;
+    return b.evaluate(u, v);
+}
+
+/// Fills `starts` (see BSplineSurface).
+void fill_starts(BSplineSurface& b) {
+    int gu = 0, gv = 0;
+    start_grid(b, gu, gv);
+    b.starts.clear();
+    b.starts.reserve(static_cast<std::size_t>((gu + 1) * (gv + 1)));
+    double u = 0, v = 0;
+    for (int j = 0; j <= gv; ++j)
+        for (int i = 0; i <= gu; ++i) b.starts.push_back(start_point(b, gu, gv, i, j, u, v));
+}
+
+/// The nearest of the grid of start_grid(): a start for project_bspline().
 void coarse_start(const BSplineSurface& b, Vec3 p, double& u, double& v) {
     double best = std::numeric_limits<double>::infinity();
-    constexpr int kGrid = 16;
-    const int gu = b.extruded ? kProfileGrid * b.num_u : kGrid, gv = b.extruded ? 0 : kGrid;
+    int gu = 0, gv = 0;
+    start_grid(b, gu, gv);
+    const bool cached = b.starts.size() == static_cast<std::size_t>((gu + 1) * (gv + 1));
     for (int j = 0; j <= gv; ++j) {
         for (int i = 0; i <= gu; ++i) {
-            const double uu = static_cast<double>(i) / gu,
-                         vv = gv > 0 ? static_cast<double>(j) / gv : 0.5;
-            const Vec3 q = b.evaluate(uu, vv) - p;
+            double uu = 0, vv = 0;
+            const Vec3 q = (cached ? b.starts[static_cast<std::size_t>(i + (gu + 1) * j)]
+                                   : start_point(b, gu, gv, i, j, uu, vv)) -
+                           p;
             const double d2 = dot(q, q);
-            if (d2 < best) best = d2, u = uu, v = vv;
+            if (d2 < best) {
+                best = d2;
+                u = static_cast<double>(i) / gu;
+                v = gv > 0 ? static_cast<double>(j) / gv : 0.5;
+            }
         }
     }
 }
@@ -1052,6 +1088,7 @@ void coarse_start(const BSplineSurface& b, Vec3 p, double& u, double& v) {
 /// direction (an extrusion's); `iterations` its number of poles.
 FitResult bspline_fit(std::shared_ptr<BSplineSurface> bs, Vec3 point, Vec3 axis, double rms,
                       double max, int iterations) {
+    fill_starts(*bs);
     FitResult r;
     r.ok = true;
     r.surface.kind = FitKind::kBSpline;
@@ -1099,9 +1136,10 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
     std::vector<double> u(n), v(n);
     for (std::size_t i = 0; i < n; ++i)
         u[i] = (x[i] - x0) / (x1 - x0), v[i] = (y[i] - y0) / (y1 - y0);
-    // Net sizes: 4 along the shorter side to start, proportional to the extents.
+    // Net sizes: 4 along the shorter side to start (then kNetGrowth x as many), proportional to
+    // the extents.
     const double aspect = (x1 - x0) / (y1 - y0);
-    int base = kBSplineStartPoles;
+    double base = kBSplineStartPoles;
     const auto max_poles =
         static_cast<int>(std::min<std::size_t>(n / 2, kBSplineMaxPoles * kBSplineMaxPoles));
     FitResult best = fail;
@@ -1209,7 +1247,7 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
         FitResult r = bspline_fit(std::move(bs), c, nrm, std::sqrt(sum / total), mx, nu * nv);
         best = r;
         if (mx <= tolerance) return r;
-        base *= 2;
+        base *= kNetGrowth;
     }
     if (best.ok) {
         best.ok = false;
@@ -1269,7 +1307,7 @@ constexpr double kCoarseNetMiss = 2;
 /// span nothing, it would take more than kProfilePieces joins, or the profile is closed.
 bool profile_parameters(const std::vector<double>& x, const std::vector<double>& y,
                         const std::vector<double>& ux, const std::vector<double>& uy,
-                        double tolerance, std::vector<double>& s) {
+                        double tolerance, std::vector<double>& s, std::vector<double>& s_turn) {
     const std::size_t n = x.size();
     double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -1382,19 +1420,25 @@ bool profile_parameters(const std::vector<double>& x, const std::vector<double>&
         if (!std::isfinite(best)) return false;
         join(ba, bb, best);
     }
-    // Distances along the tree.
-    std::vector<double> d(m);
+    // Distances along the tree: its links' lengths, or the angles the normals turn by along them.
+    std::vector<double> d(m), turn(m);
+    const auto angle = [&](std::uint32_t a, std::uint32_t b) {
+        return std::fabs(std::atan2(mx[a] * my[b] - my[a] * mx[b], mx[a] * mx[b] + my[a] * my[b]));
+    };
     const auto farthest = [&](std::uint32_t from) {
         std::fill(d.begin(), d.end(), -1.0);
         std::vector<std::uint32_t> stack{from};
-        d[from] = 0;
+        d[from] = turn[from] = 0;
         std::uint32_t far = from;
         while (!stack.empty()) {
             const std::uint32_t v = stack.back();
             stack.pop_back();
             if (d[v] > d[far]) far = v;
-            for (const auto& [w, len] : tree[v])
-                if (d[w] < 0) d[w] = d[v] + len, stack.push_back(w);
+            for (const auto& [w, len] : tree[v]) {
+                if (d[w] >= 0) continue;
+                d[w] = d[v] + len, turn[w] = turn[v] + angle(v, w);
+                stack.push_back(w);
+            }
         }
         return far;
     };
@@ -1407,8 +1451,18 @@ bool profile_parameters(const std::vector<double>& x, const std::vector<double>&
     for (const auto& links : tree)
         for (const auto& link : links) longest = std::max(longest, link.second);
     if (dist(end, other) <= kClosedProfile * longest && along(end, other)) return false;
+    // The parameters: the length along the profile, and half that length and half the turning
+    // of the normal (none for a profile that does not turn). Uniform knots in the second put
+    // more poles where the profile bends sharply: a tight bend of a spline outline that a net
+    // spread by length alone misses (trimesh_featuretype's wall, finely meshed).
+    const double total_turn = turn[other];
     s.resize(n);
     for (std::size_t i = 0; i < n; ++i) s[i] = d[node[i]] / d[other];
+    s_turn.clear();
+    if (total_turn > 0) {
+        s_turn.resize(n);
+        for (std::size_t i = 0; i < n; ++i) s_turn[i] = 0.5 * (s[i] + turn[node[i]] / total_turn);
+    }
     return true;
 }
 
@@ -1433,7 +1487,7 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
     frame(e, e1, e2);
     double total = 0;
     const Vec3 c = centroid(in, &total);
-    std::vector<double> x(n), y(n), t(n), ux(n), uy(n), s;
+    std::vector<double> x(n), y(n), t(n), ux(n), uy(n);
     double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
     for (std::size_t i = 0; i < n; ++i) {
         const Vec3 q = in.points[i] - c;
@@ -1441,38 +1495,50 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
         ux[i] = dot(in.normals[i], e1), uy[i] = dot(in.normals[i], e2);
         t0 = std::min(t0, t[i]), t1 = std::max(t1, t[i]);
     }
-    if (!(t1 > t0) || !profile_parameters(x, y, ux, uy, tolerance, s)) {
+    std::vector<double> by_length, by_turn;
+    if (!(t1 > t0) || !profile_parameters(x, y, ux, uy, tolerance, by_length, by_turn)) {
         fail.failure = "the points along the extrusion are not one open profile";
         return fail;
     }
+    // The points in the plane across e and their parameters, followed by chord points.
+    struct Profile {
+        std::vector<double> x, y, s;
+    };
     // Chords across the gaps: a coarse mesh leaves steps of several millimetres along a flat
     // stretch of the profile, where a knot span may hold no point and the curve would bulge
     // between its neighbours (2 mm on trimesh_featuretype's wall). Points on the chord between
     // consecutive points (kFillStep apart in the parameter, weighted kFillWeight) hold it there:
     // the mesh's own facets are those chords, within its deflection of the surface.
-    {
+    const auto with_chords = [&](std::vector<double> s) {
+        Profile p{x, y, std::move(s)};
         std::vector<std::size_t> by_s(n);
         std::iota(by_s.begin(), by_s.end(), std::size_t{0});
-        std::sort(by_s.begin(), by_s.end(),
-                  [&](std::size_t a, std::size_t b) { return s[a] != s[b] ? s[a] < s[b] : a < b; });
+        std::sort(by_s.begin(), by_s.end(), [&](std::size_t a, std::size_t b) {
+            return p.s[a] != p.s[b] ? p.s[a] < p.s[b] : a < b;
+        });
         for (std::size_t k = 1; k < n; ++k) {
             const std::size_t a = by_s[k - 1], b = by_s[k];
-            const auto steps = static_cast<int>((s[b] - s[a]) / kFillStep);
+            const auto steps = static_cast<int>((p.s[b] - p.s[a]) / kFillStep);
             for (int j = 1; j < steps; ++j) {
                 const double f = static_cast<double>(j) / steps;
-                x.push_back(x[a] + f * (x[b] - x[a]));
-                y.push_back(y[a] + f * (y[b] - y[a]));
-                s.push_back(s[a] + f * (s[b] - s[a]));
+                p.x.push_back(x[a] + f * (x[b] - x[a]));
+                p.y.push_back(y[a] + f * (y[b] - y[a]));
+                p.s.push_back(p.s[a] + f * (p.s[b] - p.s[a]));
             }
         }
-    }
-    const std::size_t all = s.size();
+        return p;
+    };
+    std::vector<Profile> starts{with_chords(std::move(by_length))};
+    if (!by_turn.empty()) starts.push_back(with_chords(std::move(by_turn)));
     const double fill_weight = kFillWeight * total / static_cast<double>(n);
     const auto w_of = [&](std::size_t i) { return i < n ? weight(in, i) : fill_weight; };
-    FitResult best = fail;
-    const std::vector<double> s0 = s;
-    for (int np = kBSplineStartPoles; np <= kBSplineMaxPoles; np *= 2) {
-        s = s0;  // each net from the profile's own parameters, not a coarser net's projections
+    // The profile of np poles from a start; nothing when the least-squares system fails or the
+    // net is given up for a finer one.
+    const auto fit_profile = [&](int np, const Profile& start) -> std::optional<FitResult> {
+        const std::vector<double>& px_ = start.x;
+        const std::vector<double>& py_ = start.y;
+        std::vector<double> s = start.s;  // each net from the profile's own parameters
+        const std::size_t all = s.size();
         Eigen::VectorXd px, py;
         // The distance of each point from the curve in the plane across (its distance from
         // the extrusion: every point lies within the extrusion's span), from its projection.
@@ -1488,7 +1554,7 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
             }
         };
         const auto project = [&]() {
-            double worst = 0;
+            double far = 0;
             for (std::size_t i = 0; i < all; ++i) {
                 double u = s[i], cx = 0, cy = 0, dx = 0, dy = 0;
                 for (int it = 0; it < kProjectIterations; ++it) {
@@ -1496,7 +1562,7 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
                     const double dd = dx * dx + dy * dy;
                     if (!(dd > 0)) break;
                     const double nu =
-                        std::clamp(u - ((cx - x[i]) * dx + (cy - y[i]) * dy) / dd, 0.0, 1.0);
+                        std::clamp(u - ((cx - px_[i]) * dx + (cy - py_[i]) * dy) / dd, 0.0, 1.0);
                     const bool done = std::fabs(nu - u) < 1e-13;
                     u = nu;
                     if (done) break;
@@ -1504,11 +1570,11 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
                 s[i] = u;
                 if (i < n) {
                     curve(u, cx, cy, dx, dy);
-                    off[i] = std::hypot(cx - x[i], cy - y[i]);
-                    worst = std::max(worst, off[i]);
+                    off[i] = std::hypot(cx - px_[i], cy - py_[i]);
+                    far = std::max(far, off[i]);
                 }
             }
-            return worst;
+            return far;
         };
         double worst = std::numeric_limits<double>::infinity();
         bool last = false;
@@ -1521,8 +1587,8 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
                 const int sp = basis(3, np, s[i], N, nullptr) - 3;
                 const double w = w_of(i);
                 for (int a = 0; a <= 3; ++a) {
-                    bx(sp + a) += w * N[a] * x[i];
-                    by(sp + a) += w * N[a] * y[i];
+                    bx(sp + a) += w * N[a] * px_[i];
+                    by(sp + a) += w * N[a] * py_[i];
                     for (int b = 0; b <= 3; ++b) A(sp + a, sp + b) += w * N[a] * N[b];
                 }
             }
@@ -1535,7 +1601,8 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
             }
             const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
             px = ldlt.solve(bx), py = ldlt.solve(by);
-            if (ldlt.info() != Eigen::Success || !px.allFinite() || !py.allFinite()) return best;
+            if (ldlt.info() != Eigen::Success || !px.allFinite() || !py.allFinite())
+                return std::nullopt;
             // New parameters: each point's projection onto the curve (Newton from its own).
             const double now = project();
             if (last) {
@@ -1550,9 +1617,8 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
             // A net still far off after a few rounds makes way for a finer one.
             if (round + 1 >= kCoarseNetRounds && now > kCoarseNetMiss * tolerance &&
                 np < kBSplineMaxPoles)
-                break;
+                return std::nullopt;
         }
-        if (!(worst <= tolerance) && np < kBSplineMaxPoles) continue;  // a finer net
         auto bs = std::make_shared<BSplineSurface>();
         bs->num_u = np, bs->num_v = 4;
         bs->extruded = true;
@@ -1566,10 +1632,28 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
             sum += weight(in, i) * off[i] * off[i];
             mx = std::max(mx, off[i]);
         }
-        FitResult r = bspline_fit(std::move(bs), c, e, std::sqrt(sum / total), mx, 4 * np);
-        if (mx <= tolerance) return r;
-        best = r;
+        return bspline_fit(std::move(bs), c, e, std::sqrt(sum / total), mx, 4 * np);
+    };
+    // Nets of kNetGrowth x as many poles each time, the last of kBSplineMaxPoles; at each
+    // size the start by length, then the one by turning. The first within the tolerance (and
+    // the RMS goal) wins; failing the goal, the first within the tolerance.
+    FitResult best = fail;
+    std::optional<FitResult> within;
+    for (int np = kBSplineStartPoles;;) {
+        for (const Profile& start : starts) {
+            auto r = fit_profile(np, start);
+            if (!r) continue;
+            if (r->max <= tolerance) {
+                if (!(in.rms_goal > 0 && r->rms > in.rms_goal)) return *r;
+                if (!within) within = std::move(r);
+            } else if (np == kBSplineMaxPoles && (!best.surface.bspline || r->max < best.max)) {
+                best = *r;
+            }
+        }
+        if (np == kBSplineMaxPoles) break;
+        np = std::min(kBSplineMaxPoles, static_cast<int>(std::ceil(np * kNetGrowth)));
     }
+    if (within) return *within;
     best.ok = false;
     best.failure = "no profile of up to the size limit of poles reaches the tolerance";
     return best;
