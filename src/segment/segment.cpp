@@ -44,6 +44,9 @@ constexpr int kFreeformMaxPoles = 256;
 /// An extrusion replaces its pieces only within this multiple of their RMS residual (see
 /// merge_freeform()).
 constexpr double kFreeformRms = 2;
+/// Pieces of a group that are not chords of its B-spline are left out of it while they hold at
+/// most this share of its facets (see merge_freeform()).
+constexpr double kFreeformStrayShare = 0.02;
 /// Vertices a region needs before a kind is fitted to it: one more than the kind's parameters
 /// (plane 3, sphere 4, cylinder 5, cone 6, torus 7), except the plane of a single facet. With
 /// no spare point any point set fits: the corners of a rectangle and a strip of its neighbour
@@ -651,6 +654,28 @@ std::size_t free_parameters(const Surface& s) {
     return s.bspline->extruded ? 2 * nu + 2 : nu * nv;
 }
 
+/// Regions' free parameters together and the RMS residual of their vertices from their surfaces.
+struct Pieces {
+    std::size_t parameters = 0;
+    double rms = 0;
+};
+Pieces measure_pieces(Context& c, const std::vector<Draft>& drafts,
+                      std::span<const std::uint32_t> pieces) {
+    Pieces out;
+    double sum = 0, count = 0;
+    for (const std::uint32_t p : pieces) {
+        out.parameters += free_parameters(drafts[p].surface);
+        PointSet own;
+        c.gatherers.local().gather(c.m, c.fd, drafts[p].faces, own);
+        const FitResult r = residuals(drafts[p].surface, FitInput{own.points, own.normals, {}});
+        const auto np = static_cast<double>(own.points.size());
+        sum += r.rms * r.rms * np;
+        count += np;
+    }
+    out.rms = count > 0 ? std::sqrt(sum / count) : 0;
+    return out;
+}
+
 /// Groups of at least kFreeformMinPieces curved (non-plane) regions joined by smooth edges
 /// that one B-spline of at most kFreeformMaxPoles fits (an extrusion: with fewer free
 /// parameters than the pieces together, within kFreeformRms x their RMS) become one free-form
@@ -710,10 +735,41 @@ std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
         c.gatherers.local().gather(c.m, c.fd, faces, ps);
         // Unweighted: the smoothing term is scaled to the weights, and area weights (tiny
         // near dense borders) let the net drift there (0.46 against 0.036 on a coarse die).
-        FitResult r = fit_bspline(FitInput{ps.points, ps.normals, {}}, c.sag);
+        FitInput in{ps.points, ps.normals, {}};
+        // An extrusion is held to kFreeformRms x the pieces' RMS (below): its profile gets the
+        // poles that takes, if it can.
+        Pieces whole = measure_pieces(c, drafts, g);
+        in.rms_goal = kFreeformRms * whole.rms;
+        FitResult r = fit_bspline(in, c.sag);
         if (!r.ok || r.max > c.sag ||
             r.surface.bspline->num_u * r.surface.bspline->num_v > kFreeformMaxPoles)
             continue;
+        // Leftovers at a free-form face's rims (a few facets bridging it and its floor, grown
+        // into a plane or a torus of their own) join the group through smooth edges but are no
+        // chords of its surface: the group goes on without them, while they are a small part of
+        // it (they are dissolved into their neighbours afterwards).
+        const double limit = 2 * c.sag;  // as chords_agree() for a B-spline
+        std::vector<std::uint32_t> kept;
+        std::size_t stray = 0;
+        for (const std::uint32_t p : g) {
+            const auto& pf = drafts[p].faces;
+            const bool chords = std::none_of(pf.begin(), pf.end(), [&](std::uint32_t f) {
+                return distance(r.surface, c.fd.centroid[f]) > limit;
+            });
+            if (chords)
+                kept.push_back(p);
+            else
+                stray += pf.size();
+        }
+        if (stray > 0) {
+            if (kept.size() < kFreeformMinPieces ||
+                static_cast<double>(stray) >
+                    kFreeformStrayShare * static_cast<double>(faces.size()))
+                continue;
+            faces.clear();
+            for (const std::uint32_t p : kept)
+                faces.insert(faces.end(), drafts[p].faces.begin(), drafts[p].faces.end());
+        }
         if (!chords_agree(c, r.surface, faces)) continue;
         // An extrusion said in fewer numbers by its pieces: a chain of tangent analytic faces
         // (the arcs and lines of a pocket's outline) is an extrusion too, its profile of many
@@ -724,27 +780,16 @@ std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
         // face's pieces only within the tolerance (without this, NIST CTC 01 and 03 lose a
         // chain of coarse fillets to one extrusion: Segment.FindsTheFacesOfPrismaticCorpusParts).
         if (r.surface.bspline->extruded) {
-            std::size_t pieces = 0;
-            double sum = 0, count = 0;
-            for (const std::uint32_t p : g) {
-                pieces += free_parameters(drafts[p].surface);
-                PointSet own_points;
-                c.gatherers.local().gather(c.m, c.fd, drafts[p].faces, own_points);
-                const FitResult own = residuals(
-                    drafts[p].surface, FitInput{own_points.points, own_points.normals, {}});
-                const auto np = static_cast<double>(own_points.points.size());
-                sum += own.rms * own.rms * np;
-                count += np;
-            }
-            const double pieces_rms = count > 0 ? std::sqrt(sum / count) : 0;
-            if (free_parameters(r.surface) >= pieces || r.rms > kFreeformRms * pieces_rms) continue;
+            if (stray > 0) whole = measure_pieces(c, drafts, kept);
+            if (free_parameters(r.surface) >= whole.parameters || r.rms > kFreeformRms * whole.rms)
+                continue;
         }
         std::sort(faces.begin(), faces.end());
-        drafts[g.front()].faces = std::move(faces);
-        drafts[g.front()].surface = r.surface;
-        for (std::size_t i = 1; i < g.size(); ++i) {
-            drafts[g[i]].alive = false;
-            drafts[g[i]].faces.clear();
+        drafts[kept.front()].faces = std::move(faces);
+        drafts[kept.front()].surface = r.surface;
+        for (std::size_t i = 1; i < kept.size(); ++i) {
+            drafts[kept[i]].alive = false;
+            drafts[kept[i]].faces.clear();
         }
         ++replaced;
     }
@@ -874,8 +919,13 @@ Region final_region(Context& c, const Draft& d, std::span<const SurfaceRecord> r
         out.fit =
             residuals(surface_from_record(records[static_cast<std::size_t>(d.surface_index)]), in);
     } else if (d.surface.kind == FitKind::kBSpline) {
-        out.fit = fit_bspline(FitInput{ps.points, ps.normals, {}}, c.sag);  // as merge_freeform()
-        if (!out.fit.ok) out.fit = residuals(d.surface, in);
+        // The surface merge_freeform() fitted while it holds the region's vertices as it did
+        // (refining the borders moves a few facets); refitted otherwise.
+        out.fit = residuals(d.surface, in);
+        if (!(out.fit.max <= c.sag)) {
+            FitResult again = fit_bspline(FitInput{ps.points, ps.normals, {}}, c.sag);
+            if (again.ok) out.fit = std::move(again);
+        }
     } else {
         // A settled region's own kind first (no four failed fits to a million facets of a
         // torus); otherwise the simplest kind afresh (a band of a cone grown from a few
