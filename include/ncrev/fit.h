@@ -117,6 +117,9 @@ struct FitInput {
     /// When positive, a linear extrusion (fit_bspline()) goes on to profiles of more poles
     /// until its RMS residual is within this too, not only its max within the tolerance.
     double rms_goal = 0;
+    /// When positive, a linear extrusion's profile has at most this many poles (a caller that
+    /// would take no larger one spares the fits).
+    int max_profile_poles = 0;
 };
 
 /// The outcome of one fit: `ok` false when the points do not determine the surface (too few,

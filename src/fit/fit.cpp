@@ -1473,8 +1473,10 @@ bool profile_parameters(const std::vector<double>& x, const std::vector<double>&
 /// points' projections), extruded over the points' span along e. The result is a B-spline
 /// surface of degree 3 with 4 collinear, evenly spaced poles across (so exactly linear that
 /// way). ok false when the normals are not all normal to one direction, the profile is not one
-/// open curve, or no net up to kBSplineMaxPoles poles along it reaches `tolerance`.
-FitResult fit_extrusion(const FitInput& in, double tolerance) {
+/// open curve, or no net up to kBSplineMaxPoles poles (or `max_profile_poles`: then `capped`)
+/// along it reaches `tolerance`.
+FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
+    capped = false;
     FitResult fail = failed(FitKind::kBSpline, "not a linear extrusion");
     const std::size_t n = in.points.size();
     if (in.normals.size() != n || n < 16) return fail;
@@ -1640,6 +1642,10 @@ FitResult fit_extrusion(const FitInput& in, double tolerance) {
     FitResult best = fail;
     std::optional<FitResult> within;
     for (int np = kBSplineStartPoles;;) {
+        if (in.max_profile_poles > 0 && np > in.max_profile_poles) {
+            capped = true;
+            break;
+        }
         for (const Profile& start : starts) {
             auto r = fit_profile(np, start);
             if (!r) continue;
@@ -1941,8 +1947,15 @@ FitResult fit_bspline(const FitInput& in, double tolerance) {
         }
     }
     // A wall extruded along one direction first: its net is a profile's, not a grid's.
-    FitResult extrusion = fit_extrusion(in, tolerance);
+    bool capped = false;
+    FitResult extrusion = fit_extrusion(in, tolerance, capped);
     if (extrusion.ok) return extrusion;
+    // An extrusion whose profile would need more poles than the caller takes is still one: no
+    // net over its mean plane either.
+    if (capped) {
+        extrusion.failure = "the profile needs more poles than max_profile_poles";
+        return extrusion;
+    }
     return fit_bspline_impl(in, tolerance);
 }
 
