@@ -78,8 +78,10 @@ BENCHMARK(BM_Reverse)
 // The exact B-rep (method auto, as `ncrev reverse` runs by default) on a real part of about
 // 100 faces and on a finely tessellated sample: NIST CTC 03 (139 faces, from ../shared/corpus)
 // at 0.02 mm (17k facets: BRepMesh's finer tessellations of that file have cracks, so they are
-// open meshes and go planar) and fillet_chamfer_block (26 faces) at 0.0006 mm (80k facets).
-// Issue 8's target: ~100 faces from 100k facets to STEP in <= 5 s.
+// open meshes and go planar), fillet_chamfer_block (26 faces) at 0.0006 mm (80k facets), and
+// trimesh_featuretype (96 faces, 79 unified, one a spline wall; ../shared/corpus) at 1e-3 of
+// its size and 1 degree (82k facets). Issue 8's target: ~100 faces from 100k facets to STEP in
+// <= 5 s.
 struct SurfacesCase {
     std::string name;
     TriangleSoup soup;
@@ -99,6 +101,17 @@ const SurfacesCase& surfaces_case(int which) {
         so.angular_deflection = 0.08;
         const auto path = std::filesystem::path(NCREV_SOURCE_DIR) / ".." / "shared" / "corpus" /
                           "step" / "nist_ctc_03_asme1_rc.stp";
+        auto made = sample_from_step(path, so);
+        if (made) {
+            c.soup = made->mesh;
+            c.true_faces = made->faces.size();
+        }
+    } else if (which == 2) {
+        c.name = "trimesh_featuretype";
+        so.relative_deflection = 1e-3;
+        so.angular_deflection = 0.02;
+        const auto path = std::filesystem::path(NCREV_SOURCE_DIR) / ".." / "shared" / "corpus" /
+                          "step" / "trimesh_featuretype.step";
         auto made = sample_from_step(path, so);
         if (made) {
             c.soup = made->mesh;
@@ -161,7 +174,7 @@ void BM_ReverseSurfaces(benchmark::State& state) {
     state.SetLabel(c.name + " " + to_string(options.method));
 }
 BENCHMARK(BM_ReverseSurfaces)
-    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->ArgsProduct({{0, 1, 2}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
