@@ -1537,8 +1537,8 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
     // The profile of np poles from a start; nothing when the least-squares system fails or the
     // net is given up for a finer one.
     const auto fit_profile = [&](int np, const Profile& start) -> std::optional<FitResult> {
-        const std::vector<double>& px_ = start.x;
-        const std::vector<double>& py_ = start.y;
+        const std::vector<double>& xs = start.x;
+        const std::vector<double>& ys = start.y;
         std::vector<double> s = start.s;  // each net from the profile's own parameters
         const std::size_t all = s.size();
         Eigen::VectorXd px, py;
@@ -1564,7 +1564,7 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
                     const double dd = dx * dx + dy * dy;
                     if (!(dd > 0)) break;
                     const double nu =
-                        std::clamp(u - ((cx - px_[i]) * dx + (cy - py_[i]) * dy) / dd, 0.0, 1.0);
+                        std::clamp(u - ((cx - xs[i]) * dx + (cy - ys[i]) * dy) / dd, 0.0, 1.0);
                     const bool done = std::fabs(nu - u) < 1e-13;
                     u = nu;
                     if (done) break;
@@ -1572,7 +1572,7 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
                 s[i] = u;
                 if (i < n) {
                     curve(u, cx, cy, dx, dy);
-                    off[i] = std::hypot(cx - px_[i], cy - py_[i]);
+                    off[i] = std::hypot(cx - xs[i], cy - ys[i]);
                     far = std::max(far, off[i]);
                 }
             }
@@ -1589,8 +1589,8 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
                 const int sp = basis(3, np, s[i], N, nullptr) - 3;
                 const double w = w_of(i);
                 for (int a = 0; a <= 3; ++a) {
-                    bx(sp + a) += w * N[a] * px_[i];
-                    by(sp + a) += w * N[a] * py_[i];
+                    bx(sp + a) += w * N[a] * xs[i];
+                    by(sp + a) += w * N[a] * ys[i];
                     for (int b = 0; b <= 3; ++b) A(sp + a, sp + b) += w * N[a] * N[b];
                 }
             }

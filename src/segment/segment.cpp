@@ -750,7 +750,8 @@ std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
         // Leftovers at a free-form face's rims (a few facets bridging it and its floor, grown
         // into a plane or a torus of their own) join the group through smooth edges but are no
         // chords of its surface: the group goes on without them, while they are a small part of
-        // it (they are dissolved into their neighbours afterwards).
+        // it (those of at most kSmallRegion facets are dissolved into their neighbours
+        // afterwards, larger ones stay regions of their own).
         const double limit = 2 * c.sag;  // as chords_agree() for a B-spline
         std::vector<std::uint32_t> kept;
         std::size_t stray = 0;
