@@ -95,37 +95,31 @@ const SurfacesCase& surfaces_case(int which) {
     SurfacesCase c;
     SampleOptions so;
     so.with_step = false;
+    Result<SamplePart> made = Error{};
+    const auto corpus = [&](const char* file) {
+        return sample_from_step(
+            std::filesystem::path(NCREV_SOURCE_DIR) / ".." / "shared" / "corpus" / "step" / file,
+            so);
+    };
     if (which == 0) {
         c.name = "nist_ctc_03";
         so.deflection = 0.02;
         so.angular_deflection = 0.08;
-        const auto path = std::filesystem::path(NCREV_SOURCE_DIR) / ".." / "shared" / "corpus" /
-                          "step" / "nist_ctc_03_asme1_rc.stp";
-        auto made = sample_from_step(path, so);
-        if (made) {
-            c.soup = made->mesh;
-            c.true_faces = made->faces.size();
-        }
+        made = corpus("nist_ctc_03_asme1_rc.stp");
     } else if (which == 2) {
         c.name = "trimesh_featuretype";
         so.relative_deflection = 1e-3;
         so.angular_deflection = 0.02;
-        const auto path = std::filesystem::path(NCREV_SOURCE_DIR) / ".." / "shared" / "corpus" /
-                          "step" / "trimesh_featuretype.step";
-        auto made = sample_from_step(path, so);
-        if (made) {
-            c.soup = made->mesh;
-            c.true_faces = made->faces.size();
-        }
+        made = corpus("trimesh_featuretype.step");
     } else {
         c.name = "fillet_chamfer_block";
         so.deflection = 0.0006;
         so.angular_deflection = 0.05;
-        auto made = make_sample_part(c.name, so);
-        if (made) {
-            c.soup = made->mesh;
-            c.true_faces = made->faces.size();
-        }
+        made = make_sample_part(c.name, so);
+    }
+    if (made) {
+        c.soup = made->mesh;
+        c.true_faces = made->faces.size();
     }
     // What an STL carries: triangles only.
     c.soup.color.clear();
