@@ -662,9 +662,9 @@ TEST(FitBSpline, ExtrudedWallIsOneProfileExtruded) {
     EXPECT_FALSE(fit_bspline(FitInput{ring, ring_normals, {}}, tol).ok);
 }
 
-// A wall along a hairpin profile (a parabola of 0.5 mm vertex radius whose arms run 36 mm):
-// nets spread by length along the profile put a pole or two on the bend and miss it; the start
-// by length and turning puts many there.
+// A wall along a hairpin profile (a parabola of 0.25 mm vertex radius whose arms run 72 mm):
+// nets spread by length along the profile put a pole or two on the bend and miss it (this fails
+// with that start alone); the start by length and turning puts many there.
 TEST(FitBSpline, ExtrusionFollowsATightBend) {
     const double radius = 0.25;
     std::vector<Vec3> points, normals;

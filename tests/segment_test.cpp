@@ -259,10 +259,10 @@ TEST(Segment, NoisyMeshesAreSegmentedAtTheirNoise) {
     }
 }
 
-// The die's free-form top meshed at 3 degrees (1536 facets): the net of 9 x 8 poles misses the
-// chordal deflection there by a hundredth of a millimetre and the next, 17 x 16, is too large
-// for one face; nets growing by half reach it at 10 x 9. Without that the top came back as 180
-// pieces (or, after a noise pass mistaking their misfit for noise, 90).
+// The die's free-form top meshed at 3 degrees (1536 facets): doubling the net from 4 x 4 went
+// from one that misses the chordal deflection to one of more poles than a face may have (this
+// fails with kNetGrowth 2: 95 regions, after a noise pass that took the pieces' misfit for
+// noise); nets growing by half reach it within the limit.
 TEST(Segment, FinelyMeshedFreeFormFaceIsOneBSpline) {
     SampleOptions so;
     so.with_step = false;

@@ -1045,9 +1045,15 @@ void start_grid(const BSplineSurface& b, int& gu, int& gv) {
     gv = b.extruded ? 0 : kGrid;
 }
 
-Vec3 start_point(const BSplineSurface& b, int gu, int gv, int i, int j, double& u, double& v) {
+/// The parameters of the grid's point (i, j).
+void start_params(int gu, int gv, int i, int j, double& u, double& v) {
     u = static_cast<double>(i) / gu;
     v = gv > 0 ? static_cast<double>(j) / gv : 0.5;
+}
+
+Vec3 start_point(const BSplineSurface& b, int gu, int gv, int i, int j) {
+    double u = 0, v = 0;
+    start_params(gu, gv, i, j, u, v);
     return b.evaluate(u, v);
 }
 
@@ -1057,9 +1063,8 @@ void fill_starts(BSplineSurface& b) {
     start_grid(b, gu, gv);
     b.starts.clear();
     b.starts.reserve(static_cast<std::size_t>((gu + 1) * (gv + 1)));
-    double u = 0, v = 0;
     for (int j = 0; j <= gv; ++j)
-        for (int i = 0; i <= gu; ++i) b.starts.push_back(start_point(b, gu, gv, i, j, u, v));
+        for (int i = 0; i <= gu; ++i) b.starts.push_back(start_point(b, gu, gv, i, j));
 }
 
 /// The nearest of the grid of start_grid(): a start for project_bspline().
@@ -1068,20 +1073,17 @@ void coarse_start(const BSplineSurface& b, Vec3 p, double& u, double& v) {
     int gu = 0, gv = 0;
     start_grid(b, gu, gv);
     const bool cached = b.starts.size() == static_cast<std::size_t>((gu + 1) * (gv + 1));
+    int bi = 0, bj = 0;
     for (int j = 0; j <= gv; ++j) {
         for (int i = 0; i <= gu; ++i) {
-            double uu = 0, vv = 0;
             const Vec3 q = (cached ? b.starts[static_cast<std::size_t>(i + (gu + 1) * j)]
-                                   : start_point(b, gu, gv, i, j, uu, vv)) -
+                                   : start_point(b, gu, gv, i, j)) -
                            p;
             const double d2 = dot(q, q);
-            if (d2 < best) {
-                best = d2;
-                u = static_cast<double>(i) / gu;
-                v = gv > 0 ? static_cast<double>(j) / gv : 0.5;
-            }
+            if (d2 < best) best = d2, bi = i, bj = j;
         }
     }
+    start_params(gu, gv, bi, bj, u, v);
 }
 
 /// A fitted B-spline: `point` and `axis` its mean plane's (a net's) or its centroid and
@@ -1644,6 +1646,7 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
     for (int np = kBSplineStartPoles;;) {
         if (in.max_profile_poles > 0 && np > in.max_profile_poles) {
             capped = true;
+            best.failure = "the profile needs more poles than max_profile_poles";
             break;
         }
         for (const Profile& start : starts) {
@@ -1661,7 +1664,7 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
     }
     if (within) return *within;
     best.ok = false;
-    best.failure = "no profile of up to the size limit of poles reaches the tolerance";
+    if (!capped) best.failure = "no profile of up to the size limit of poles reaches the tolerance";
     return best;
 }
 
@@ -1952,10 +1955,7 @@ FitResult fit_bspline(const FitInput& in, double tolerance) {
     if (extrusion.ok) return extrusion;
     // An extrusion whose profile would need more poles than the caller takes is still one: no
     // net over its mean plane either.
-    if (capped) {
-        extrusion.failure = "the profile needs more poles than max_profile_poles";
-        return extrusion;
-    }
+    if (capped) return extrusion;
     return fit_bspline_impl(in, tolerance);
 }
 
