@@ -773,6 +773,58 @@ struct Builder {
     }
 };
 
+// How a chain's edge was made (the report's edges by curve).
+enum class ChainKind : std::uint8_t { kIntersection, kTangency, kFitted };
+
+// The geometry one build round computed, which the next reuses while what it was computed
+// from is unchanged (build_surface_brep): a round differs from the one before only around the
+// regions that failed, and solving every corner and intersecting every pair of surfaces again
+// cost most of a finely meshed part's B-rep. Topology (vertices, edges, faces) is built afresh
+// every round: the faces' fixes replace edges and vertices, which a kept edge would carry into
+// the next round's faces.
+struct GeometryCache {
+    // A corner: what it is solved from (the regions with a surface around it, whether it may
+    // go onto a contact curve) and the result.
+    struct Corner {
+        bool valid = false;
+        std::vector<std::int32_t> on;
+        bool contact_allowed = false;
+        Vec3 point{};
+        double tolerance = 0;
+        bool solved = false;  // had surfaces to be solved onto
+        bool on_contact = false;
+        double residual = 0;
+    };
+    // A chain's curve between two surfaces: what it is made from (its regions' states:
+    // fallback, piecewise-linear tangent edges; its end points) and the curve.
+    struct Chain {
+        bool valid = false;
+        std::array<std::uint8_t, 4> state{};
+        gp_Pnt p0, p1;
+        ChainCurve curve;
+        ChainKind kind = ChainKind::kFitted;
+        bool analytic = false;
+        // What its edges are made from: `id` names the curve, `polyline_id` the segments
+        // between the end points `q0`, `q1` (new ids when they change).
+        std::uint64_t id = 0, polyline_id = 0;
+        gp_Pnt q0, q1;
+    };
+    // A face that passed the checks (OpenCASCADE's, BRepMesh's), made from: its surface and
+    // orientation, whether it was a fallback's face bounded by mesh edges, and the ids of the
+    // chains around it. The same face again needs no checks.
+    struct Face {
+        bool valid = false;
+        Handle(Geom_Surface) surface;
+        int sense = 1;
+        bool fallback = false;
+        std::vector<std::uint64_t> chains;
+    };
+    std::unordered_map<std::uint32_t, Corner> corners;
+    std::vector<Chain> chains;
+    std::vector<Face> faces;
+    std::uint64_t next_id = 1;
+};
+
 }  // namespace
 
 SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& region,
@@ -900,10 +952,12 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         }
         return !geom[r].IsNull();
     };
-    // After absorbing: borders, loops and the neighbours' geometry again.
+    GeometryCache cache;
+    // After absorbing: borders, loops and the neighbours' geometry again (nothing kept).
     const auto relabelled = [&] {
         bd.prepare();
         compute_geometry();
+        cache = GeometryCache{};
     };
     if (!opt.allow_fallback) {
         for (std::size_t r = 0; r < nr; ++r) {
@@ -924,6 +978,52 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     };
 
     BRep_Builder B;
+    // Corner v solved onto the surfaces of the regions `on`.
+    const auto solve_corner = [&](VertexId v, const std::vector<std::int32_t>& on_ids,
+                                  bool contact_allowed) {
+        GeometryCache::Corner c;
+        c.valid = true;
+        c.on = on_ids;
+        c.contact_allowed = contact_allowed;
+        std::vector<Surface> on;
+        for (std::int32_t r : on_ids) on.push_back(regions[static_cast<std::size_t>(r)].surface);
+        Vec3 p = m.position(v);
+        double tol = kMinTolerance;
+        if (!on.empty()) {
+            CommonPoint cp = common_point(on, p);
+            // Two tangent surfaces leave the solve free along their contact band: the corner
+            // goes onto their contact curve when that is within the tolerance of every surface
+            // and within the band (its half-width sqrt(2 r tol), r the tube's radius).
+            Vec3 q = cp.point;
+            double radius = 0;
+            if (contact_allowed && on.size() >= 3 && tangent_corner(on, opt.tolerance, q, radius)) {
+                double residual = 0;
+                for (const Surface& s : on) residual = std::max(residual, distance(s, q));
+                const double band = std::sqrt(2 * radius * opt.tolerance);
+                if (residual <= opt.tolerance && norm(q - p) <= max_tol + 2 * band) {
+                    cp.point = q;
+                    cp.residual = residual;
+                    c.on_contact = true;
+                }
+            }
+            c.solved = true;
+            if (cp.residual <= opt.tolerance && (c.on_contact || norm(cp.point - p) <= max_tol)) {
+                p = cp.point;
+                tol = std::max(tol, 1.01 * cp.residual);
+                c.residual = cp.residual;
+            } else {
+                // Unsolved (surfaces nearly tangent, or a bad fit): the mesh vertex, with the
+                // tolerance that reaches every surface.
+                double d = 0;
+                for (const Surface& s : on) d = std::max(d, distance(s, p));
+                tol = std::max(tol, 1.01 * d);
+                c.residual = d;
+            }
+        }
+        c.point = p;
+        c.tolerance = tol;
+        return c;
+    };
     for (int round = 1; round <= kMaxRounds; ++round) {
         out.rounds = round;
         out.intersection_edges = out.tangency_edges = out.fitted_edges = out.polyline_edges = 0;
@@ -944,57 +1044,33 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         const auto solved_vertex = [&](VertexId v) -> TopoDS_Vertex {
             auto it = vertex.find(v.idx());
             if (it != vertex.end()) return it->second;
-            std::vector<Surface> on;
+            std::vector<std::int32_t> on;
             const std::vector<std::int32_t> around = regions_at(v);
             // Not on a contact curve where that failed here before, or around a region whose
             // face came back wrong from a STEP written with one (opt.plain_corners).
             bool contact_allowed = plain_at.count(v.idx()) == 0;
             for (std::int32_t r : around) {
                 const auto k = static_cast<std::size_t>(r);
-                if (!fallback[k]) on.push_back(regions[k].surface);
+                if (!fallback[k]) on.push_back(r);
                 if (k < opt.plain_corners.size() && opt.plain_corners[k]) contact_allowed = false;
             }
-            Vec3 p = m.position(v);
-            double tol = kMinTolerance;
-            if (!on.empty()) {
-                CommonPoint cp = common_point(on, p);
-                // Two tangent surfaces leave the solve free along their contact band: the
-                // corner goes onto their contact curve when that is within the tolerance of
-                // every surface and within the band (its half-width sqrt(2 r tol), r the
-                // tube's radius).
-                Vec3 q = cp.point;
-                bool on_contact = false;
-                double radius = 0;
-                if (contact_allowed && on.size() >= 3 &&
-                    tangent_corner(on, opt.tolerance, q, radius)) {
-                    double residual = 0;
-                    for (const Surface& s : on) residual = std::max(residual, distance(s, q));
-                    const double band = std::sqrt(2 * radius * opt.tolerance);
-                    if (residual <= opt.tolerance && norm(q - p) <= max_tol + 2 * band) {
-                        cp.point = q;
-                        cp.residual = residual;
-                        on_contact = true;
-                        ++out.tangent_corners;
-                        for (std::int32_t r : around)
-                            contact_at[static_cast<std::size_t>(r)].push_back(v.idx());
-                    }
-                }
-                if (cp.residual <= opt.tolerance && (on_contact || norm(cp.point - p) <= max_tol)) {
-                    p = cp.point;
-                    tol = std::max(tol, 1.01 * cp.residual);
-                    out.max_corner_residual = std::max(out.max_corner_residual, cp.residual);
-                } else {
-                    // Unsolved (surfaces nearly tangent, or a bad fit): the mesh vertex, with
-                    // the tolerance that reaches every surface.
-                    double d = 0;
-                    for (const Surface& s : on) d = std::max(d, distance(s, p));
-                    tol = std::max(tol, 1.01 * d);
-                    out.max_corner_residual = std::max(out.max_corner_residual, d);
-                }
+            GeometryCache::Corner& c = cache.corners[v.idx()];
+            if (!opt.reuse_geometry || !c.valid || c.on != on ||
+                c.contact_allowed != contact_allowed) {
+                c = solve_corner(v, on, contact_allowed);
+                ++out.corners_solved;
+            }
+            if (c.solved) {
                 ++out.corners;
+                out.max_corner_residual = std::max(out.max_corner_residual, c.residual);
+            }
+            if (c.on_contact) {
+                ++out.tangent_corners;
+                for (std::int32_t r : around)
+                    contact_at[static_cast<std::size_t>(r)].push_back(v.idx());
             }
             TopoDS_Vertex V;
-            B.MakeVertex(V, pnt(p), tol);
+            B.MakeVertex(V, pnt(c.point), c.tolerance);
             vertex.emplace(v.idx(), V);
             return V;
         };
@@ -1024,6 +1100,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
 
         // 3. Edges: per chain, its edges in chain order, each running along the chain.
         std::vector<std::vector<TopoDS_Edge>> chain_edges(borders.chains.size());
+        cache.chains.resize(borders.chains.size());
+        // Per chain, what its edges are made from this round (GeometryCache::Chain).
+        std::vector<std::uint64_t> chain_id(borders.chains.size(), 0);
         std::vector<std::int32_t> failed_chain;
         for (std::size_t c = 0; c < borders.chains.size(); ++c) {
             const BorderChain& ch = borders.chains[c];
@@ -1035,94 +1114,131 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             if (!polyline) {
                 const TopoDS_Vertex V0 = solved_vertex(v0);
                 const TopoDS_Vertex V1 = ch.closed ? V0 : solved_vertex(v1);
-                const Surface& sa = regions[ra].surface;
-                const Surface& sb = regions[rb].surface;
-                // The chain's points: the solved ends, the interior vertices solved onto both.
-                std::vector<gp_Pnt> pts;
-                pts.reserve(ch.vertices.size());
-                const std::array<Surface, 2> pair{sa, sb};
-                double min_sin = 1;
-                for (std::size_t k = 0; k < ch.vertices.size(); ++k) {
-                    const bool end = k == 0 || k + 1 == ch.vertices.size();
-                    if (end) {
-                        pts.push_back(BRep_Tool::Pnt(k == 0 ? V0 : V1));
-                    } else {
-                        pts.push_back(pnt(common_point(pair, m.position(ch.vertices[k])).point));
-                    }
-                    const Vec3 p = vec(pts.back());
-                    min_sin = std::min(min_sin, norm(cross(normal_at(sa, p), normal_at(sb, p))));
-                }
-                const bool tangent = min_sin <= std::sin(kTangentAngle);
-                // A tangent junction with a fillet (a cylinder, torus or sphere: a tube about a
-                // spine): where they touch is exact, the foot on the other surface of the
-                // spine point nearest each chain point. Solving onto both surfaces instead is
-                // ill-conditioned there: any point of the band where they are within the
-                // tolerance of each other is a solution, and the curve wanders across it.
-                // Taken when the curve through those points is within the tolerance of both
-                // surfaces (two cylinders crossing at a shallow angle are not tangent along a
-                // curve, and the feet are not where they meet).
-                std::vector<gp_Pnt> touch;
-                if (tangent && pts.size() > 2 &&
-                    tangency_points(sa, sb, m, ch.vertices, max_tol, touch)) {
-                    touch.front() = pts.front();
-                    touch.back() = pts.back();
-                } else {
-                    touch.clear();
-                }
+                GeometryCache::Chain& kept = cache.chains[c];
+                const std::array<std::uint8_t, 4> state{fallback[ra], fallback[rb], linear[ra],
+                                                        linear[rb]};
+                const gp_Pnt p0 = BRep_Tool::Pnt(V0), p1 = BRep_Tool::Pnt(V1);
                 ChainCurve cc;
                 bool ok = false, intersected = false, touched = false;
+                if (opt.reuse_geometry && kept.valid && kept.state == state &&
+                    kept.p0.IsEqual(p0, 0) && kept.p1.IsEqual(p1, 0)) {
+                    // The curve of the round before (a copy: this round's fixes may change its
+                    // edge's).
+                    cc = kept.curve;
+                    cc.curve = Handle(Geom_Curve)::DownCast(kept.curve.curve->Copy());
+                    ok = true;
+                    intersected = kept.kind == ChainKind::kIntersection;
+                    touched = kept.kind == ChainKind::kTangency;
+                    if (kept.analytic) ++out.analytic_edges;
+                } else {
+                    kept = GeometryCache::Chain{};
+                    ++out.curves_made;
+                    kept.state = state;
+                    kept.p0 = p0;
+                    kept.p1 = p1;
+                    const Surface& sa = regions[ra].surface;
+                    const Surface& sb = regions[rb].surface;
+                    // The chain's points: the solved ends, the interior vertices solved onto both.
+                    std::vector<gp_Pnt> pts;
+                    pts.reserve(ch.vertices.size());
+                    const std::array<Surface, 2> pair{sa, sb};
+                    double min_sin = 1;
+                    for (std::size_t k = 0; k < ch.vertices.size(); ++k) {
+                        const bool end = k == 0 || k + 1 == ch.vertices.size();
+                        if (end) {
+                            pts.push_back(BRep_Tool::Pnt(k == 0 ? V0 : V1));
+                        } else {
+                            pts.push_back(
+                                pnt(common_point(pair, m.position(ch.vertices[k])).point));
+                        }
+                        const Vec3 p = vec(pts.back());
+                        min_sin =
+                            std::min(min_sin, norm(cross(normal_at(sa, p), normal_at(sb, p))));
+                    }
+                    const bool tangent = min_sin <= std::sin(kTangentAngle);
+                    // A tangent junction with a fillet (a cylinder, torus or sphere: a tube about a
+                    // spine): where they touch is exact, the foot on the other surface of the
+                    // spine point nearest each chain point. Solving onto both surfaces instead is
+                    // ill-conditioned there: any point of the band where they are within the
+                    // tolerance of each other is a solution, and the curve wanders across it.
+                    // Taken when the curve through those points is within the tolerance of both
+                    // surfaces (two cylinders crossing at a shallow angle are not tangent along a
+                    // curve, and the feet are not where they meet).
+                    std::vector<gp_Pnt> touch;
+                    if (tangent && pts.size() > 2 &&
+                        tangency_points(sa, sb, m, ch.vertices, max_tol, touch)) {
+                        touch.front() = pts.front();
+                        touch.back() = pts.back();
+                    } else {
+                        touch.clear();
+                    }
+                    try {
+                        if (!tangent) {
+                            bool analytic = false;
+                            ok = intersection_curve(geom[ra], geom[rb], pts, ch.closed,
+                                                    opt.chordal_deflection + opt.tolerance, cc,
+                                                    analytic);
+                            intersected = ok;
+                            kept.analytic = ok && analytic;
+                        }
+                        if (!ok) {
+                            // The curve through the exact contact points where there are some and
+                            // it stays within the tolerance of both surfaces; otherwise the
+                            // closest to the surfaces of: the cubic through the chain's points,
+                            // the cubic through them densified, the piecewise-linear one (where a
+                            // cubic swings off the surfaces: points unevenly spaced, a kink where
+                            // the chain leaves the junction). Densified only where the surfaces
+                            // cross: along a tangent junction every point of a band about the
+                            // tangency line is on both to the tolerance, and solved points would
+                            // wander across it. The curve's distance from the two surfaces is its
+                            // tolerance.
+                            const std::vector<gp_Pnt> dense =
+                                tangent ? pts : densified(pts, pair, opt.tolerance);
+                            const int samples = 4 * static_cast<int>(dense.size());
+                            ChainCurve best;
+                            best.deviation = -1;
+                            if (!touch.empty() &&
+                                fitted_curve(touch, ch.closed, linear[ra] || linear[rb], best)) {
+                                best.deviation = curve_off_surfaces(best, sa, sb, samples);
+                                touched = best.deviation <= max_tol;
+                                if (!touched) best.deviation = -1;
+                            }
+                            for (int variant = 0; variant < 3 && !touched; ++variant) {
+                                ChainCurve t;
+                                if (!fitted_curve(variant == 0 ? pts : dense, ch.closed,
+                                                  variant == 2, t)) {
+                                    continue;
+                                }
+                                t.deviation = curve_off_surfaces(t, sa, sb, samples);
+                                // A region whose wire crossed itself gets the piecewise-linear
+                                // curve along its tangent junctions: a cubic through many close
+                                // points wiggles across the tangency band, and its curve on the
+                                // flat neighbour can cross the next edge's near their vertex.
+                                if (variant == 2 && (linear[ra] || linear[rb]) && tangent &&
+                                    t.deviation <= max_tol) {
+                                    best = t;
+                                    break;
+                                }
+                                if (best.deviation < 0 || t.deviation < best.deviation) best = t;
+                            }
+                            ok = best.deviation >= 0 && best.deviation <= max_tol;
+                            if (ok) cc = best;
+                        }
+                    } catch (const Standard_Failure&) {
+                        ok = false;
+                    }
+                    if (ok) {
+                        kept.valid = true;
+                        kept.id = cache.next_id++;
+                        kept.curve = cc;
+                        kept.curve.curve = Handle(Geom_Curve)::DownCast(cc.curve->Copy());
+                        kept.kind = intersected ? ChainKind::kIntersection
+                                    : touched   ? ChainKind::kTangency
+                                                : ChainKind::kFitted;
+                        if (kept.analytic) ++out.analytic_edges;
+                    }
+                }
                 try {
-                    if (!tangent) {
-                        bool analytic = false;
-                        ok = intersection_curve(geom[ra], geom[rb], pts, ch.closed,
-                                                opt.chordal_deflection + opt.tolerance, cc,
-                                                analytic);
-                        intersected = ok;
-                        if (ok && analytic) ++out.analytic_edges;
-                    }
-                    if (!ok) {
-                        // The curve through the exact contact points where there are some and
-                        // it stays within the tolerance of both surfaces; otherwise the
-                        // closest to the surfaces of: the cubic through the chain's points,
-                        // the cubic through them densified, the piecewise-linear one (where a
-                        // cubic swings off the surfaces: points unevenly spaced, a kink where
-                        // the chain leaves the junction). Densified only where the surfaces
-                        // cross: along a tangent junction every point of a band about the
-                        // tangency line is on both to the tolerance, and solved points would
-                        // wander across it. The curve's distance from the two surfaces is its
-                        // tolerance.
-                        const std::vector<gp_Pnt> dense =
-                            tangent ? pts : densified(pts, pair, opt.tolerance);
-                        const int samples = 4 * static_cast<int>(dense.size());
-                        ChainCurve best;
-                        best.deviation = -1;
-                        if (!touch.empty() &&
-                            fitted_curve(touch, ch.closed, linear[ra] || linear[rb], best)) {
-                            best.deviation = curve_off_surfaces(best, sa, sb, samples);
-                            touched = best.deviation <= max_tol;
-                            if (!touched) best.deviation = -1;
-                        }
-                        for (int variant = 0; variant < 3 && !touched; ++variant) {
-                            ChainCurve t;
-                            if (!fitted_curve(variant == 0 ? pts : dense, ch.closed, variant == 2,
-                                              t)) {
-                                continue;
-                            }
-                            t.deviation = curve_off_surfaces(t, sa, sb, samples);
-                            // A region whose wire crossed itself gets the piecewise-linear
-                            // curve along its tangent junctions: a cubic through many close
-                            // points wiggles across the tangency band, and its curve on the
-                            // flat neighbour can cross the next edge's near their vertex.
-                            if (variant == 2 && (linear[ra] || linear[rb]) && tangent &&
-                                t.deviation <= max_tol) {
-                                best = t;
-                                break;
-                            }
-                            if (best.deviation < 0 || t.deviation < best.deviation) best = t;
-                        }
-                        ok = best.deviation >= 0 && best.deviation <= max_tol;
-                        if (ok) cc = best;
-                    }
                     if (ok) {
                         // The vertices reach the curve's ends.
                         const gp_Pnt e0 = cc.curve->Value(cc.first), e1 = cc.curve->Value(cc.last);
@@ -1144,10 +1260,24 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 } catch (const Standard_Failure&) {
                     ok = false;
                 }
-                if (ok) continue;
+                if (ok) {
+                    chain_id[c] = cache.chains[c].id;
+                    continue;
+                }
                 failed_chain.push_back(static_cast<std::int32_t>(c));
             }
             // The chain's own segments.
+            {
+                GeometryCache::Chain& kept = cache.chains[c];
+                const gp_Pnt q0 = BRep_Tool::Pnt(plain_vertex(v0));
+                const gp_Pnt q1 = BRep_Tool::Pnt(plain_vertex(v1));
+                if (kept.polyline_id == 0 || !kept.q0.IsEqual(q0, 0) || !kept.q1.IsEqual(q1, 0)) {
+                    kept.polyline_id = cache.next_id++;
+                    kept.q0 = q0;
+                    kept.q1 = q1;
+                }
+                chain_id[c] = kept.polyline_id;
+            }
             for (std::size_t k = 0; k + 1 < ch.vertices.size(); ++k) {
                 bool fwd = true;
                 TopoDS_Edge e = segment_edge(ch.vertices[k], ch.vertices[k + 1], fwd);
@@ -1211,6 +1341,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         // 4. Faces.
         Handle(ShapeBuild_ReShape) context = new ShapeBuild_ReShape;
         std::vector<std::vector<TopoDS_Face>> faces(nr);
+        cache.faces.resize(nr);
         std::vector<std::pair<std::size_t, std::string>> failed_region;
         // A surface face that fails is retried or falls back (below); a fallback region's face
         // bounded by its mesh edges that fails leaves the region as its facets.
@@ -1230,6 +1361,20 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 as_facets[r] = 1;
                 continue;
             }
+            // Made from the same as a face that passed the checks before: no checks.
+            GeometryCache::Face made;
+            made.surface = geom[r];
+            made.sense = sense[r];
+            made.fallback = fallback[r] != 0;
+            for (const auto& loop : bd.loops[r]) {
+                for (const auto& lc : loop) {
+                    made.chains.push_back(chain_id[static_cast<std::size_t>(lc.first)]);
+                }
+            }
+            const GeometryCache::Face& passed = cache.faces[r];
+            const bool checked = opt.reuse_geometry && passed.valid &&
+                                 passed.surface == made.surface && passed.sense == made.sense &&
+                                 passed.fallback == made.fallback && passed.chains == made.chains;
             try {
                 TopoDS_Face F;
                 if (bd.loops[r].empty()) {
@@ -1294,11 +1439,12 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     }
                 }
                 if (sense[r] < 0) F.Reverse();
-                if (std::string why = check_failure(F); !why.empty()) {
+                if (!checked) ++out.faces_checked;
+                if (std::string why = checked ? std::string() : check_failure(F); !why.empty()) {
                     face_failed(r, "its face fails OpenCASCADE's check (" + why + ")");
                     continue;
                 }
-                if (opt.mesh_deflection > 0) {
+                if (opt.mesh_deflection > 0 && !checked) {
                     BRepMesh_IncrementalMesh(F, opt.mesh_deflection, false, 0.2, false);
                     TopLoc_Location loc;
                     if (BRep_Tool::Triangulation(F, loc).IsNull()) {
@@ -1310,6 +1456,8 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     BRepTools::Clean(F);
                 }
                 faces[r].push_back(F);
+                made.valid = true;
+                cache.faces[r] = std::move(made);
             } catch (const Standard_Failure& f) {
                 face_failed(
                     r, std::string("OpenCASCADE fails building its face: ") + f.GetMessageString());

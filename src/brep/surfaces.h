@@ -43,6 +43,10 @@ struct SurfaceBrepOptions {
     /// Per region (may be empty): a fallback region comes back as its facets, not as one face
     /// on its surface bounded by its mesh edges (that face failed in a STEP written before).
     std::vector<std::uint8_t> as_facets;
+    /// A round after the first keeps the corners, edge curves and face checks of the round
+    /// before whose inputs did not change (only those around the regions that failed do);
+    /// false solves everything again each round (the same result, slower: for tests).
+    bool reuse_geometry = true;
 };
 
 /// What happened to one region.
@@ -82,6 +86,9 @@ struct SurfaceBrep {
     double max_corner_residual = 0;  ///< largest distance of a solved corner from its surfaces
     double max_tolerance = 0;        ///< largest vertex / edge / face tolerance of the result
     int rounds = 0;                  ///< build rounds (each one after new fallbacks)
+    /// Work over all rounds: corners solved onto their surfaces, edge curves made (each an
+    /// intersection or a fit between two surfaces), faces checked.
+    std::uint64_t corners_solved = 0, curves_made = 0, faces_checked = 0;
 };
 
 /// Builds the B-rep of the closed, outward-oriented `mesh` whose face f belongs to region
