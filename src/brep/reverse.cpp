@@ -1,5 +1,7 @@
 // reverse_to_step(): mesh -> B-rep (facets, planar, or surfaces with the local fallback) ->
 // check -> STEP, with the numbers.
+#include <tbb/task_group.h>
+
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepGProp.hxx>
 #include <GProp_GProps.hxx>
@@ -8,6 +10,7 @@
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <chrono>
 #include <numeric>
+#include <optional>
 
 #include "brep/deviation.h"
 #include "brep/planar.h"
@@ -488,10 +491,25 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         // What a CAD system will see: the file read back (STEP keeps no tolerances; the reader
         // derives them) must pass the check too — up to kOcctCheckMaxFaces faces (reading and
         // checking cost ~1 ms a face; larger B-reps are all but fallback facets).
+        // The deviation is measured meanwhile, on the solid in memory (which reading the file
+        // does not touch; the two take about as long), and dropped if the file reads back
+        // wrong.
         brep_detail::ReadBack back;
-        if (rep.faces <= kOcctCheckMaxFaces) {
-            stage("verify", [&] { back = brep_detail::step_read_back(output); });
-        }
+        std::optional<SolidDeviation> deviation;
+        const bool verify = rep.faces <= kOcctCheckMaxFaces;
+        const char* name = !verify                     ? "measure"
+                           : options.measure_deviation ? "verify+measure"
+                                                       : "verify";
+        stage(name, [&] {
+            tbb::task_group measuring;
+            if (options.measure_deviation) {
+                measuring.run([&] {
+                    deviation = brep_detail::measure_deviation(brep.shape, mesh, deflection);
+                });
+            }
+            if (verify) back = brep_detail::step_read_back(output);
+            measuring.wait();
+        });
         const std::string& back_problem = back.problem;
         if (!back_problem.empty() && options.method == ReverseMethod::kAuto &&
             attempt < kReadBackRetries) {
@@ -514,11 +532,9 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                                    "): nothing written");
             return rep;
         }
-        // Measured once, on the solid that was written (the triangulation is reused).
-        if (options.measure_deviation) {
-            stage("measure", [&] {
-                rep.deviation = brep_detail::measure_deviation(brep.shape, mesh, deflection);
-            });
+        // Measured on the solid that was written (the triangulation is reused).
+        if (deviation) {
+            rep.deviation = std::move(deviation);
             if (rep.deviation->faces_without_triangles > 0) {
                 rep.warnings.push_back(
                     std::to_string(rep.deviation->faces_without_triangles) +
