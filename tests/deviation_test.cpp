@@ -1,4 +1,4 @@
-// The deviation measure's grid search against brute force (an internal module: src/brep).
+// The deviation measure's tree search against brute force (an internal module: src/brep).
 #include "brep/deviation.h"
 
 #include <gtest/gtest.h>
@@ -23,10 +23,10 @@ namespace ncrev {
 namespace {
 
 // A cylinder turned about a skew axis: BRepMesh gives its side long thin triangles along the
-// axis, none parallel to the grid's axes, each listed in many cells. The mesh: the same
+// axis, none parallel to the coordinate axes, their boxes overlapping. The mesh: the same
 // cylinder at 64 x 24 cells with fans on the caps, its side pushed in and out by up to 0.3 mm,
-// so that every distance is its own. The grid search must give the brute-force distances.
-TEST(Deviation, GridDistancesAreTheBruteForceOnes) {
+// so that every distance is its own. The tree search must give the brute-force distances.
+TEST(Deviation, TreeDistancesAreTheBruteForceOnes) {
     gp_Trsf turn;
     turn.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(1, 2, 3)), 0.7);
     constexpr double kRadius = 10, kHeight = 30;

@@ -1,6 +1,6 @@
-// Distances between a B-rep and a mesh through a uniform grid of triangles: the B-rep is
-// triangulated finely (BRepMesh), each query point searches the grid's cells ring by ring
-// outward until no nearer triangle can exist.
+// Distances between a B-rep and a mesh through a bounding-volume hierarchy of triangles: the
+// B-rep is triangulated finely (BRepMesh), each query point descends the tree of the other
+// side's triangles, skipping every box farther than the nearest triangle found.
 #include "brep/deviation.h"
 
 #include <tbb/blocked_range.h>
@@ -20,6 +20,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 namespace ncrev::brep_detail {
 
@@ -50,123 +52,130 @@ namespace {
 
 using Triangle = std::array<Vec3, 3>;
 
-class TriangleGrid {
+// A bounding-volume hierarchy of triangles: boxes split at the median of their triangles'
+// centres along their longest side, down to kLeafTriangles. A nearest-triangle query descends
+// nearer child first and skips every box farther than the best distance found. Unlike a
+// uniform grid it needs no cell size: a B-rep's triangulation mixes triangles a hundred times
+// larger (planes) than others (fillets), and a tessellated part's long strips (extrusions)
+// would fill a grid's cells by the thousand.
+class TriangleTree {
    public:
-    explicit TriangleGrid(std::vector<Triangle> tris) : tris_(std::move(tris)) {
-        for (const Triangle& t : tris_) {
-            for (const Vec3& p : t) box_.add(p);
+    explicit TriangleTree(std::vector<Triangle> tris) : tris_(std::move(tris)) {
+        if (tris_.empty()) return;
+        std::vector<Vec3> centre(tris_.size());
+        for (std::size_t i = 0; i < tris_.size(); ++i) {
+            centre[i] = (1.0 / 3) * (tris_[i][0] + tris_[i][1] + tris_[i][2]);
         }
-        // Cells about twice the mean triangle size: a few triangles each.
-        double edge = 0;
-        for (const Triangle& t : tris_) edge += norm(t[1] - t[0]) + norm(t[2] - t[1]);
-        edge = tris_.empty() ? 1 : edge / (2.0 * static_cast<double>(tris_.size()));
-        const Vec3 ext = box_.max - box_.min;
-        cell_ = std::max({2 * edge, 1e-9 * (ext.x + ext.y + ext.z), 1e-12});
-        for (int k = 0; k < 3; ++k) {
-            const double e = k == 0 ? ext.x : k == 1 ? ext.y : ext.z;
-            n_[k] = std::clamp(static_cast<int>(e / cell_) + 1, 1, 1024);
-        }
-        // Grow the cell when the grid would be too large.
-        while (static_cast<double>(n_[0]) * n_[1] * n_[2] > 8.0 * tris_.size() + 64) {
-            cell_ *= 1.5;
-            for (int k = 0; k < 3; ++k) {
-                const double e = k == 0 ? ext.x : k == 1 ? ext.y : ext.z;
-                n_[k] = std::clamp(static_cast<int>(e / cell_) + 1, 1, 1024);
-            }
-        }
-        start_.assign(static_cast<std::size_t>(n_[0]) * n_[1] * n_[2] + 1, 0);
-        const auto each_cell = [&](const Triangle& t, auto&& f) {
-            std::array<int, 3> lo{}, hi{};
-            for (int k = 0; k < 3; ++k) {
-                const double mn = std::min({coord(t[0], k), coord(t[1], k), coord(t[2], k)});
-                const double mx = std::max({coord(t[0], k), coord(t[1], k), coord(t[2], k)});
-                lo[k] = index(mn, k);
-                hi[k] = index(mx, k);
-            }
-            for (int z = lo[2]; z <= hi[2]; ++z)
-                for (int y = lo[1]; y <= hi[1]; ++y)
-                    for (int x = lo[0]; x <= hi[0]; ++x) f(cell_id(x, y, z));
-        };
-        for (const Triangle& t : tris_) each_cell(t, [&](std::size_t c) { ++start_[c + 1]; });
-        for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
-        items_.resize(start_.back());
-        std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
-        for (std::uint32_t i = 0; i < tris_.size(); ++i) {
-            each_cell(tris_[i], [&](std::size_t c) { items_[fill[c]++] = i; });
-        }
+        order_.resize(tris_.size());
+        for (std::uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
+        nodes_.reserve(4 * tris_.size() / kLeafTriangles + 1);
+        nodes_.emplace_back();
+        build(0, 0, static_cast<std::uint32_t>(order_.size()), centre);
+        // Leaves hold their triangles in tree order: a query reads them one after another.
+        std::vector<Triangle> sorted(tris_.size());
+        for (std::size_t i = 0; i < order_.size(); ++i) sorted[i] = tris_[order_[i]];
+        tris_ = std::move(sorted);
     }
 
     /// Distance from p to the nearest triangle.
     double distance(Vec3 p) const {
         if (tris_.empty()) return 0;
-        std::array<int, 3> c{};
-        for (int k = 0; k < 3; ++k) c[k] = index(coord(p, k), k);
-        double best2 = 1e300;
-        const int max_ring = std::max({n_[0], n_[1], n_[2]});
-        for (int ring = 0; ring <= max_ring; ++ring) {
-            for (int z = c[2] - ring; z <= c[2] + ring; ++z) {
-                if (z < 0 || z >= n_[2]) continue;
-                for (int y = c[1] - ring; y <= c[1] + ring; ++y) {
-                    if (y < 0 || y >= n_[1]) continue;
-                    for (int x = c[0] - ring; x <= c[0] + ring; ++x) {
-                        if (x < 0 || x >= n_[0]) continue;
-                        if (std::max({std::abs(x - c[0]), std::abs(y - c[1]),
-                                      std::abs(z - c[2])}) != ring) {
-                            continue;
-                        }
-                        const std::size_t id = cell_id(x, y, z);
-                        for (std::uint32_t i = start_[id]; i < start_[id + 1]; ++i) {
-                            const Triangle& t = tris_[items_[i]];
-                            const Vec3 q = closest_on_triangle(p, t[0], t[1], t[2]);
-                            best2 = std::min(best2, dot(p - q, p - q));
-                        }
-                    }
+        double best2 = std::numeric_limits<double>::infinity();
+        // Each level leaves at most one node on the stack (two pushed, one taken): 64 covers
+        // any depth a 32-bit triangle count gives.
+        std::array<std::uint32_t, 64> stack{};
+        std::size_t top = 0;
+        stack[top++] = 0;
+        while (top > 0) {
+            const Node& n = nodes_[stack[--top]];
+            if (box_distance2(n.box, p) >= best2) continue;
+            if (n.count > 0) {
+                for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
+                    const Triangle& t = tris_[i];
+                    const Vec3 q = closest_on_triangle(p, t[0], t[1], t[2]);
+                    best2 = std::min(best2, dot(p - q, p - q));
                 }
+                continue;
             }
-            // Every triangle not yet seen is in a cell outside the block searched: at least
-            // `ring` cells away (the point is inside its clamped cell, or outside the grid,
-            // which only makes them farther), and at least as far as the block's nearest side
-            // that has cells beyond it — most points lie on the other mesh, and stop at ring 0
-            // instead of searching the 26 cells around theirs.
-            double reach = ring * cell_;
-            double side = 1e300;
-            for (int k = 0; k < 3; ++k) {
-                const double lo = coord(box_.min, k), v = coord(p, k);
-                if (c[k] - ring > 0) side = std::min(side, v - (lo + (c[k] - ring) * cell_));
-                if (c[k] + ring < n_[k] - 1) {
-                    side = std::min(side, lo + (c[k] + ring + 1) * cell_ - v);
-                }
-            }
-            reach = std::max(reach, side);
-            if (best2 < 1e300 && best2 <= reach * reach) break;
+            // The nearer child on top of the stack, searched first.
+            const std::uint32_t a = n.first, b = n.first + 1;
+            const bool a_first = box_distance2(nodes_[a].box, p) <= box_distance2(nodes_[b].box, p);
+            stack[top++] = a_first ? b : a;
+            stack[top++] = a_first ? a : b;
         }
         return std::sqrt(best2);
     }
 
    private:
-    static double coord(Vec3 p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
-    int index(double v, int k) const {
-        const double lo = coord(box_.min, k);
-        return std::clamp(static_cast<int>(std::floor((v - lo) / cell_)), 0, n_[k] - 1);
+    // Triangles per leaf: a few closest-point tests cost less than another level of boxes.
+    static constexpr std::uint32_t kLeafTriangles = 4;
+    struct Node {
+        Box3 box;
+        std::uint32_t first = 0;  // leaf: first triangle; inner node: first of two children
+        std::uint32_t count = 0;  // triangles of a leaf, 0 for an inner node
+    };
+
+    static double box_distance2(const Box3& b, Vec3 p) {
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            const double d = std::max({b.min[k] - p[k], 0.0, p[k] - b.max[k]});
+            d2 += d * d;
+        }
+        return d2;
     }
-    std::size_t cell_id(int x, int y, int z) const {
-        return static_cast<std::size_t>(x) +
-               static_cast<std::size_t>(n_[0]) *
-                   (static_cast<std::size_t>(y) + static_cast<std::size_t>(n_[1]) * z);
+
+    // Node `slot` over order_[begin, end), its two children appended next to each other; its
+    // box the union of theirs. Depth is about log2(n / kLeafTriangles): the median split
+    // halves every range.
+    void build(std::uint32_t slot, std::uint32_t begin, std::uint32_t end,
+               const std::vector<Vec3>& centre) {
+        if (end - begin <= kLeafTriangles) {
+            Box3 box;
+            for (std::uint32_t i = begin; i < end; ++i) {
+                for (const Vec3& v : tris_[order_[i]]) box.add(v);
+            }
+            nodes_[slot].box = box;
+            nodes_[slot].first = begin;
+            nodes_[slot].count = end - begin;
+            return;
+        }
+        Vec3 lo = centre[order_[begin]], hi = lo;
+        for (std::uint32_t i = begin + 1; i < end; ++i) {
+            const Vec3 c = centre[order_[i]];
+            lo = {std::min(lo.x, c.x), std::min(lo.y, c.y), std::min(lo.z, c.z)};
+            hi = {std::max(hi.x, c.x), std::max(hi.y, c.y), std::max(hi.z, c.z)};
+        }
+        const Vec3 ext = hi - lo;
+        const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : ext.y >= ext.z ? 1 : 2;
+        const std::uint32_t mid = begin + (end - begin) / 2;
+        // Ties broken by index: the same tree whatever the standard library's partitioning.
+        std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+                         [&](std::uint32_t a, std::uint32_t b) {
+                             const double ca = centre[a][axis], cb = centre[b][axis];
+                             return ca < cb || (ca == cb && a < b);
+                         });
+        const auto left = static_cast<std::uint32_t>(nodes_.size());
+        nodes_.emplace_back();
+        nodes_.emplace_back();
+        nodes_[slot].first = left;
+        build(left, begin, mid, centre);
+        build(left + 1, mid, end, centre);
+        Box3 box = nodes_[left].box;
+        box.add(nodes_[left + 1].box);
+        nodes_[slot].box = box;
     }
+
     std::vector<Triangle> tris_;
-    Box3 box_;
-    double cell_ = 1;
-    std::array<int, 3> n_{1, 1, 1};
-    std::vector<std::uint32_t> start_, items_;
+    std::vector<std::uint32_t> order_;
+    std::vector<Node> nodes_;
 };
 
-DistanceStats stats_of(const std::vector<Vec3>& points, const TriangleGrid& grid) {
+DistanceStats stats_of(const std::vector<Vec3>& points, const TriangleTree& tree) {
     std::vector<double> d(points.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                           for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                              d[i] = grid.distance(points[i]);
+                              d[i] = tree.distance(points[i]);
                           }
                       });
     DistanceStats s;
@@ -238,8 +247,8 @@ SolidDeviation measure_deviation(const TopoDS_Shape& shape, const Mesh& mesh, do
         for (int i = 0; i < 3; ++i) mesh_tris[f][i] = mesh.position(mesh.vertex(FaceId(f), i));
     }
     std::vector<Vec3> mesh_points(mesh.positions().begin(), mesh.positions().end());
-    out.mesh_to_solid = stats_of(mesh_points, TriangleGrid(std::move(solid_tris)));
-    out.solid_to_mesh = stats_of(solid_nodes, TriangleGrid(std::move(mesh_tris)));
+    out.mesh_to_solid = stats_of(mesh_points, TriangleTree(std::move(solid_tris)));
+    out.solid_to_mesh = stats_of(solid_nodes, TriangleTree(std::move(mesh_tris)));
     return out;
 }
 
