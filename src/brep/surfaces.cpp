@@ -28,6 +28,7 @@
 #include <BRep_Tool.hxx>
 #include <GeomAPI_IntSS.hxx>
 #include <GeomAPI_Interpolate.hxx>
+#include <GeomAPI_PointsToBSpline.hxx>
 #include <GeomAPI_ProjectPointOnCurve.hxx>
 #include <GeomAPI_ProjectPointOnSurf.hxx>
 #include <GeomAdaptor_Surface.hxx>
@@ -91,6 +92,9 @@ constexpr double kTangentAngle = 0.17453292519943295;
 constexpr std::size_t kChainSamples = 24;
 // Facet centroids used to find which way a surface's natural normal points.
 constexpr std::size_t kOrientationSamples = 16;
+// Chains of more points than this get an approximating edge curve (fitted_curve()): fewer
+// take no more poles interpolated.
+constexpr std::size_t kApproximateFrom = 8;
 // Build rounds: each round turns (the smallest of) the regions whose faces failed into facets;
 // a failure spreads at most to neighbours, so a few rounds settle.
 constexpr int kMaxRounds = 12;
@@ -578,8 +582,13 @@ bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surfac
 }
 
 // A curve through `points` (already on both surfaces): a cubic interpolation, periodic when
-// the chain is closed, or (`linear`) the degree-1 B-spline through them, chord-length knots.
-bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, ChainCurve& out) {
+// the chain is closed, or (`linear`) the degree-1 B-spline through them, chord-length knots;
+// or, when `approximate` is positive and the chain open, a C2 B-spline of degree 3 to 8 within
+// `approximate` of them (through the ends), with as few poles as that takes: a fine mesh's
+// chain has hundreds of points, and an interpolation as many poles, each written to the STEP
+// with the curve's two curves on the surfaces.
+bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, ChainCurve& out,
+                  double approximate = 0) {
     std::vector<gp_Pnt> p;
     for (const gp_Pnt& q : points) {
         if (p.empty() || p.back().Distance(q) > 10 * kMinTolerance) p.push_back(q);
@@ -625,6 +634,16 @@ bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, C
     }
     Handle(TColgp_HArray1OfPnt) arr = new TColgp_HArray1OfPnt(1, static_cast<int>(p.size()));
     for (std::size_t i = 0; i < p.size(); ++i) arr->SetValue(static_cast<int>(i) + 1, p[i]);
+    if (approximate > 0) {
+        if (closed || p.size() <= kApproximateFrom) return false;
+        GeomAPI_PointsToBSpline fit(arr->Array1(), 3, 8, GeomAbs_C2, approximate);
+        if (!fit.IsDone()) return false;
+        out.curve = fit.Curve();
+        out.first = out.curve->FirstParameter();
+        out.last = out.curve->LastParameter();
+        out.deviation = 0;
+        return true;
+    }
     GeomAPI_Interpolate interp(arr, closed, kMinTolerance);
     interp.Perform();
     if (!interp.IsDone()) return false;
@@ -1203,7 +1222,20 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                                 touched = best.deviation <= max_tol;
                                 if (!touched) best.deviation = -1;
                             }
-                            for (int variant = 0; variant < 3 && !touched; ++variant) {
+                            // First the approximation within half the tolerance, taken when it
+                            // is within the tolerance of both surfaces (not where a wire crossed
+                            // itself: see below).
+                            bool approximated = false;
+                            if (!touched && !linear[ra] && !linear[rb]) {
+                                ChainCurve t;
+                                if (fitted_curve(pts, ch.closed, false, t, 0.5 * opt.tolerance)) {
+                                    t.deviation = curve_off_surfaces(t, sa, sb, samples);
+                                    approximated = t.deviation <= opt.tolerance;
+                                    if (approximated) best = t;
+                                }
+                            }
+                            for (int variant = 0; variant < 3 && !touched && !approximated;
+                                 ++variant) {
                                 ChainCurve t;
                                 if (!fitted_curve(variant == 0 ? pts : dense, ch.closed,
                                                   variant == 2, t)) {
