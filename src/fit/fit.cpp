@@ -12,12 +12,14 @@
 #include "ncrev/fit.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <Eigen/Dense>
 #include <Eigen/QR>
 #include <Eigen/Sparse>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -1649,8 +1651,12 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
             best.failure = "the profile needs more poles than max_profile_poles";
             break;
         }
-        for (const Profile& start : starts) {
-            auto r = fit_profile(np, start);
+        // The starts at once (each fit on its own; taken in order below, as one after the other
+        // would be).
+        std::array<std::optional<FitResult>, 2> fits;
+        tbb::parallel_for(std::size_t{0}, starts.size(),
+                          [&](std::size_t k) { fits[k] = fit_profile(np, starts[k]); });
+        for (std::optional<FitResult>& r : fits) {
             if (!r) continue;
             if (r->max <= tolerance) {
                 if (!(in.rms_goal > 0 && r->rms > in.rms_goal)) return *r;
