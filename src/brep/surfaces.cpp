@@ -19,6 +19,8 @@
 //    sewn to its neighbours by sharing the chain's segments — and the B-rep is rebuilt.
 #include "brep/surfaces.h"
 
+#include <tbb/parallel_for.h>
+
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepLib.hxx>
@@ -795,6 +797,14 @@ struct Builder {
 // How a chain's edge was made (the report's edges by curve).
 enum class ChainKind : std::uint8_t { kIntersection, kTangency, kFitted };
 
+// A chain's curve to make (build_surface_brep()): its end points, and the result.
+struct CurveJob {
+    std::size_t chain = 0;
+    gp_Pnt p0, p1;
+    ChainCurve cc;
+    bool ok = false, intersected = false, touched = false, analytic = false;
+};
+
 // The geometry one build round computed, which the next reuses while what it was computed
 // from is unchanged (build_surface_brep): a round differs from the one before only around the
 // regions that failed, and solving every corner and intersecting every pair of surfaces again
@@ -1122,6 +1132,145 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         cache.chains.resize(borders.chains.size());
         // Per chain, what its edges are made from this round (GeometryCache::Chain).
         std::vector<std::uint64_t> chain_id(borders.chains.size(), 0);
+        // A chain's curve between its two surfaces, from its solved end points (job.p0, p1):
+        // the intersection where they cross, else a curve fitted through the chain's points
+        // solved onto both. Reads only the surfaces and the mesh: chains are made in parallel.
+        const auto make_curve = [&](CurveJob& job) {
+            const BorderChain& ch = borders.chains[job.chain];
+            const auto ra = static_cast<std::size_t>(ch.left);
+            const auto rb = static_cast<std::size_t>(ch.right);
+            ChainCurve& cc = job.cc;
+            bool& ok = job.ok;
+            bool& intersected = job.intersected;
+            bool& touched = job.touched;
+            const Surface& sa = regions[ra].surface;
+            const Surface& sb = regions[rb].surface;
+            // The chain's points: the solved ends, the interior vertices solved onto both.
+            std::vector<gp_Pnt> pts;
+            pts.reserve(ch.vertices.size());
+            const std::array<Surface, 2> pair{sa, sb};
+            double min_sin = 1;
+            for (std::size_t k = 0; k < ch.vertices.size(); ++k) {
+                const bool end = k == 0 || k + 1 == ch.vertices.size();
+                if (end) {
+                    pts.push_back(k == 0 ? job.p0 : job.p1);
+                } else {
+                    pts.push_back(pnt(common_point(pair, m.position(ch.vertices[k])).point));
+                }
+                const Vec3 p = vec(pts.back());
+                min_sin = std::min(min_sin, norm(cross(normal_at(sa, p), normal_at(sb, p))));
+            }
+            const bool tangent = min_sin <= std::sin(kTangentAngle);
+            // A tangent junction with a fillet (a cylinder, torus or sphere: a tube about a
+            // spine): where they touch is exact, the foot on the other surface of the
+            // spine point nearest each chain point. Solving onto both surfaces instead is
+            // ill-conditioned there: any point of the band where they are within the
+            // tolerance of each other is a solution, and the curve wanders across it.
+            // Taken when the curve through those points is within the tolerance of both
+            // surfaces (two cylinders crossing at a shallow angle are not tangent along a
+            // curve, and the feet are not where they meet).
+            std::vector<gp_Pnt> touch;
+            if (tangent && pts.size() > 2 &&
+                tangency_points(sa, sb, m, ch.vertices, max_tol, touch)) {
+                touch.front() = pts.front();
+                touch.back() = pts.back();
+            } else {
+                touch.clear();
+            }
+            try {
+                if (!tangent) {
+                    bool analytic = false;
+                    ok = intersection_curve(geom[ra], geom[rb], pts, ch.closed,
+                                            opt.chordal_deflection + opt.tolerance, cc, analytic);
+                    intersected = ok;
+                    job.analytic = ok && analytic;
+                }
+                if (!ok) {
+                    // The curve through the exact contact points where there are some and
+                    // it stays within the tolerance of both surfaces; otherwise the
+                    // closest to the surfaces of: the cubic through the chain's points,
+                    // the cubic through them densified, the piecewise-linear one (where a
+                    // cubic swings off the surfaces: points unevenly spaced, a kink where
+                    // the chain leaves the junction). Densified only where the surfaces
+                    // cross: along a tangent junction every point of a band about the
+                    // tangency line is on both to the tolerance, and solved points would
+                    // wander across it. The curve's distance from the two surfaces is its
+                    // tolerance.
+                    const std::vector<gp_Pnt> dense =
+                        tangent ? pts : densified(pts, pair, opt.tolerance);
+                    const int samples = 4 * static_cast<int>(dense.size());
+                    ChainCurve best;
+                    best.deviation = -1;
+                    if (!touch.empty() &&
+                        fitted_curve(touch, ch.closed, linear[ra] || linear[rb], best)) {
+                        best.deviation = curve_off_surfaces(best, sa, sb, samples);
+                        touched = best.deviation <= max_tol;
+                        if (!touched) best.deviation = -1;
+                    }
+                    // First the approximation within half the tolerance, taken when it
+                    // is within the tolerance of both surfaces (not where a wire crossed
+                    // itself: see below).
+                    bool approximated = false;
+                    if (!touched && !linear[ra] && !linear[rb]) {
+                        ChainCurve t;
+                        if (fitted_curve(pts, ch.closed, false, t, 0.5 * opt.tolerance)) {
+                            t.deviation = curve_off_surfaces(t, sa, sb, samples);
+                            approximated = t.deviation <= opt.tolerance;
+                            if (approximated) best = t;
+                        }
+                    }
+                    for (int variant = 0; variant < 3 && !touched && !approximated; ++variant) {
+                        ChainCurve t;
+                        if (!fitted_curve(variant == 0 ? pts : dense, ch.closed, variant == 2, t)) {
+                            continue;
+                        }
+                        t.deviation = curve_off_surfaces(t, sa, sb, samples);
+                        // A region whose wire crossed itself gets the piecewise-linear
+                        // curve along its tangent junctions: a cubic through many close
+                        // points wiggles across the tangency band, and its curve on the
+                        // flat neighbour can cross the next edge's near their vertex.
+                        if (variant == 2 && (linear[ra] || linear[rb]) && tangent &&
+                            t.deviation <= max_tol) {
+                            best = t;
+                            break;
+                        }
+                        if (best.deviation < 0 || t.deviation < best.deviation) best = t;
+                    }
+                    ok = best.deviation >= 0 && best.deviation <= max_tol;
+                    if (ok) cc = best;
+                }
+            } catch (const Standard_Failure&) {
+                ok = false;
+            }
+        };
+        // The curves to make this round (the chains between two surfaces whose curve is not kept
+        // from the round before), made in parallel; their corners solved first.
+        std::vector<CurveJob> jobs;
+        std::vector<std::size_t> job_of(borders.chains.size(), 0);
+        for (std::size_t c = 0; c < borders.chains.size(); ++c) {
+            const BorderChain& ch = borders.chains[c];
+            if (ch.right < 0) continue;
+            const auto ra = static_cast<std::size_t>(ch.left),
+                       rb = static_cast<std::size_t>(ch.right);
+            if (fallback[ra] || fallback[rb]) continue;
+            const TopoDS_Vertex V0 = solved_vertex(ch.vertices.front());
+            const TopoDS_Vertex V1 = ch.closed ? V0 : solved_vertex(ch.vertices.back());
+            const gp_Pnt p0 = BRep_Tool::Pnt(V0), p1 = BRep_Tool::Pnt(V1);
+            const GeometryCache::Chain& kept = cache.chains[c];
+            const std::array<std::uint8_t, 4> state{fallback[ra], fallback[rb], linear[ra],
+                                                    linear[rb]};
+            if (opt.reuse_geometry && kept.valid && kept.state == state && kept.p0.IsEqual(p0, 0) &&
+                kept.p1.IsEqual(p1, 0)) {
+                continue;
+            }
+            job_of[c] = jobs.size();
+            CurveJob job;
+            job.chain = c;
+            job.p0 = p0;
+            job.p1 = p1;
+            jobs.push_back(std::move(job));
+        }
+        tbb::parallel_for(std::size_t{0}, jobs.size(), [&](std::size_t j) { make_curve(jobs[j]); });
         std::vector<std::int32_t> failed_chain;
         for (std::size_t c = 0; c < borders.chains.size(); ++c) {
             const BorderChain& ch = borders.chains[c];
@@ -1155,110 +1304,12 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     kept.state = state;
                     kept.p0 = p0;
                     kept.p1 = p1;
-                    const Surface& sa = regions[ra].surface;
-                    const Surface& sb = regions[rb].surface;
-                    // The chain's points: the solved ends, the interior vertices solved onto both.
-                    std::vector<gp_Pnt> pts;
-                    pts.reserve(ch.vertices.size());
-                    const std::array<Surface, 2> pair{sa, sb};
-                    double min_sin = 1;
-                    for (std::size_t k = 0; k < ch.vertices.size(); ++k) {
-                        const bool end = k == 0 || k + 1 == ch.vertices.size();
-                        if (end) {
-                            pts.push_back(BRep_Tool::Pnt(k == 0 ? V0 : V1));
-                        } else {
-                            pts.push_back(
-                                pnt(common_point(pair, m.position(ch.vertices[k])).point));
-                        }
-                        const Vec3 p = vec(pts.back());
-                        min_sin =
-                            std::min(min_sin, norm(cross(normal_at(sa, p), normal_at(sb, p))));
-                    }
-                    const bool tangent = min_sin <= std::sin(kTangentAngle);
-                    // A tangent junction with a fillet (a cylinder, torus or sphere: a tube about a
-                    // spine): where they touch is exact, the foot on the other surface of the
-                    // spine point nearest each chain point. Solving onto both surfaces instead is
-                    // ill-conditioned there: any point of the band where they are within the
-                    // tolerance of each other is a solution, and the curve wanders across it.
-                    // Taken when the curve through those points is within the tolerance of both
-                    // surfaces (two cylinders crossing at a shallow angle are not tangent along a
-                    // curve, and the feet are not where they meet).
-                    std::vector<gp_Pnt> touch;
-                    if (tangent && pts.size() > 2 &&
-                        tangency_points(sa, sb, m, ch.vertices, max_tol, touch)) {
-                        touch.front() = pts.front();
-                        touch.back() = pts.back();
-                    } else {
-                        touch.clear();
-                    }
-                    try {
-                        if (!tangent) {
-                            bool analytic = false;
-                            ok = intersection_curve(geom[ra], geom[rb], pts, ch.closed,
-                                                    opt.chordal_deflection + opt.tolerance, cc,
-                                                    analytic);
-                            intersected = ok;
-                            kept.analytic = ok && analytic;
-                        }
-                        if (!ok) {
-                            // The curve through the exact contact points where there are some and
-                            // it stays within the tolerance of both surfaces; otherwise the
-                            // closest to the surfaces of: the cubic through the chain's points,
-                            // the cubic through them densified, the piecewise-linear one (where a
-                            // cubic swings off the surfaces: points unevenly spaced, a kink where
-                            // the chain leaves the junction). Densified only where the surfaces
-                            // cross: along a tangent junction every point of a band about the
-                            // tangency line is on both to the tolerance, and solved points would
-                            // wander across it. The curve's distance from the two surfaces is its
-                            // tolerance.
-                            const std::vector<gp_Pnt> dense =
-                                tangent ? pts : densified(pts, pair, opt.tolerance);
-                            const int samples = 4 * static_cast<int>(dense.size());
-                            ChainCurve best;
-                            best.deviation = -1;
-                            if (!touch.empty() &&
-                                fitted_curve(touch, ch.closed, linear[ra] || linear[rb], best)) {
-                                best.deviation = curve_off_surfaces(best, sa, sb, samples);
-                                touched = best.deviation <= max_tol;
-                                if (!touched) best.deviation = -1;
-                            }
-                            // First the approximation within half the tolerance, taken when it
-                            // is within the tolerance of both surfaces (not where a wire crossed
-                            // itself: see below).
-                            bool approximated = false;
-                            if (!touched && !linear[ra] && !linear[rb]) {
-                                ChainCurve t;
-                                if (fitted_curve(pts, ch.closed, false, t, 0.5 * opt.tolerance)) {
-                                    t.deviation = curve_off_surfaces(t, sa, sb, samples);
-                                    approximated = t.deviation <= opt.tolerance;
-                                    if (approximated) best = t;
-                                }
-                            }
-                            for (int variant = 0; variant < 3 && !touched && !approximated;
-                                 ++variant) {
-                                ChainCurve t;
-                                if (!fitted_curve(variant == 0 ? pts : dense, ch.closed,
-                                                  variant == 2, t)) {
-                                    continue;
-                                }
-                                t.deviation = curve_off_surfaces(t, sa, sb, samples);
-                                // A region whose wire crossed itself gets the piecewise-linear
-                                // curve along its tangent junctions: a cubic through many close
-                                // points wiggles across the tangency band, and its curve on the
-                                // flat neighbour can cross the next edge's near their vertex.
-                                if (variant == 2 && (linear[ra] || linear[rb]) && tangent &&
-                                    t.deviation <= max_tol) {
-                                    best = t;
-                                    break;
-                                }
-                                if (best.deviation < 0 || t.deviation < best.deviation) best = t;
-                            }
-                            ok = best.deviation >= 0 && best.deviation <= max_tol;
-                            if (ok) cc = best;
-                        }
-                    } catch (const Standard_Failure&) {
-                        ok = false;
-                    }
+                    const CurveJob& job = jobs[job_of[c]];
+                    cc = job.cc;
+                    ok = job.ok;
+                    intersected = job.intersected;
+                    touched = job.touched;
+                    kept.analytic = job.analytic;
                     if (ok) {
                         kept.valid = true;
                         kept.id = cache.next_id++;
