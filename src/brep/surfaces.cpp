@@ -636,24 +636,22 @@ bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, C
     }
     Handle(TColgp_HArray1OfPnt) arr = new TColgp_HArray1OfPnt(1, static_cast<int>(p.size()));
     for (std::size_t i = 0; i < p.size(); ++i) arr->SetValue(static_cast<int>(i) + 1, p[i]);
+    // The whole curve.
+    const auto whole = [&out](const Handle(Geom_Curve) & c) {
+        out.curve = c;
+        out.first = c->FirstParameter();
+        out.last = c->LastParameter();
+        out.deviation = 0;
+        return true;
+    };
     if (approximate > 0) {
         if (closed || p.size() <= kApproximateFrom) return false;
         GeomAPI_PointsToBSpline fit(arr->Array1(), 3, 8, GeomAbs_C2, approximate);
-        if (!fit.IsDone()) return false;
-        out.curve = fit.Curve();
-        out.first = out.curve->FirstParameter();
-        out.last = out.curve->LastParameter();
-        out.deviation = 0;
-        return true;
+        return fit.IsDone() && whole(fit.Curve());
     }
     GeomAPI_Interpolate interp(arr, closed, kMinTolerance);
     interp.Perform();
-    if (!interp.IsDone()) return false;
-    out.curve = interp.Curve();
-    out.first = out.curve->FirstParameter();
-    out.last = out.curve->LastParameter();
-    out.deviation = 0;
-    return true;
+    return interp.IsDone() && whole(interp.Curve());
 }
 
 // The chain's points with points solved onto both surfaces inserted between them wherever
