@@ -2,14 +2,21 @@
 #include <gtest/gtest.h>
 
 #include <BRepGProp.hxx>
+#include <BRep_Tool.hxx>
 #include <GProp_GProps.hxx>
+#include <Geom_BSplineCurve.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #include "brep/surfaces.h"
+#include "ncrev/io.h"
 #include "ncrev/mesh.h"
 #include "ncrev/segment.h"
 #include "sample_cases.h"
@@ -138,6 +145,95 @@ TEST(SurfaceBrep, FacesMadeFromTheSameAreNotCheckedAgain) {
     EXPECT_GE(b.fresh.rounds, 2);
     EXPECT_LT(b.kept.faces_checked, b.fresh.faces_checked);
     EXPECT_LT(b.kept.curves_made, b.fresh.curves_made);
+}
+
+// A prism whose curved side is a linear extrusion of a B-spline profile (as fit_bspline() makes
+// for a spline pocket wall), closed by a flat wall, floor and top; meshed exactly on its
+// surfaces. Where the floor and the top cross the extrusion, the edge is the profile itself
+// moved onto the plane: a cubic of the profile's poles, on both surfaces to rounding — not
+// OpenCASCADE's general intersection (degree 8, hundreds of poles, within its approximation).
+TEST(SurfaceBrep, PlaneMeetsAnExtrusionAlongItsProfile) {
+    constexpr double kHeight = 12;
+    auto wall = std::make_shared<BSplineSurface>();
+    wall->extruded = true;
+    const std::vector<Vec3> profile{{-20, 0, 0}, {-20, 15, 0}, {-5, 25, 0},
+                                    {5, 22, 0},  {20, 15, 0},  {20, 0, 0}};
+    wall->num_u = static_cast<int>(profile.size());
+    wall->num_v = 4;
+    for (int j = 0; j < 4; ++j)
+        for (const Vec3& p : profile) {
+            // Past the floor and the top (an extrusion spans its points, not the planes'):
+            // the planes cross it inside, not along its boundary rows.
+            wall->poles.push_back(p + Vec3{0, 0, -3 + (kHeight + 6) * j / 3.0});
+        }
+    TriangleSoup soup;
+    constexpr int kAlong = 60;
+    for (int k = 0; k <= kAlong; ++k) {
+        Vec3 p = wall->evaluate(static_cast<double>(k) / kAlong, 0);
+        p.z = 0;
+        soup.points.push_back(p);
+        soup.points.push_back(p + Vec3{0, 0, kHeight});
+    }
+    const auto bottom = [](int k) { return static_cast<std::uint32_t>(2 * k); };
+    const auto top = [](int k) { return static_cast<std::uint32_t>(2 * k + 1); };
+    // The profile runs clockwise seen from above: outward is to the left of its direction.
+    for (int k = 0; k < kAlong; ++k) {
+        soup.triangles.push_back({bottom(k), top(k), top(k + 1)});
+        soup.triangles.push_back({bottom(k), top(k + 1), bottom(k + 1)});
+    }
+    soup.triangles.push_back({bottom(kAlong), top(kAlong), top(0)});  // the flat wall, y = 0
+    soup.triangles.push_back({bottom(kAlong), top(0), bottom(0)});
+    const auto centre = static_cast<std::uint32_t>(soup.points.size());
+    soup.points.push_back({0, 10, 0});
+    soup.points.push_back({0, 10, kHeight});
+    for (int k = 0; k <= kAlong; ++k) {
+        const int n = (k + 1) % (kAlong + 1);
+        soup.triangles.push_back({centre, bottom(k), bottom(n)});
+        soup.triangles.push_back({centre + 1, top(n), top(k)});
+    }
+    const Mesh mesh = build_mesh(soup).value().mesh;
+    ASSERT_EQ(mesh.num_faces(), soup.triangles.size());
+
+    std::vector<RegionSurface> surfaces(4);
+    for (RegionSurface& r : surfaces) r.has_surface = true;
+    surfaces[0].surface.kind = FitKind::kBSpline;
+    surfaces[0].surface.bspline = wall;
+    surfaces[1].surface.point = {0, 0, 0};  // planes: the flat wall, the floor, the top
+    surfaces[1].surface.axis = {0, -1, 0};
+    surfaces[2].surface.point = {0, 0, 0};
+    surfaces[2].surface.axis = {0, 0, -1};
+    surfaces[3].surface.point = {0, 0, kHeight};
+    surfaces[3].surface.axis = {0, 0, 1};
+    FaceMap<std::int32_t> region(mesh.num_faces(), 0);
+    for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
+        const Vec3 n = mesh.face_normal(FaceId(f));
+        region[FaceId(f)] = n.z > 0.9 ? 3 : n.z < -0.9 ? 2 : n.y < -0.999 ? 1 : 0;
+    }
+    SurfaceBrepOptions o;
+    o.tolerance = 0.005;
+    o.chordal_deflection = 0.05;  // the side's chords sag ~0.01 mm
+    const SurfaceBrep b = brep_detail::build_surface_brep(mesh, region, surfaces, o);
+    ASSERT_TRUE(b.valid && b.solid) << b.problem;
+    for (const auto& r : b.regions) EXPECT_FALSE(r.fallback) << r.reason;
+
+    int profiles = 0;
+    TopTools_IndexedMapOfShape edges;
+    TopExp::MapShapes(b.shape, TopAbs_EDGE, edges);
+    for (int i = 1; i <= edges.Extent(); ++i) {
+        double t0 = 0, t1 = 0;
+        const auto c =
+            Handle(Geom_BSplineCurve)::DownCast(BRep_Tool::Curve(TopoDS::Edge(edges(i)), t0, t1));
+        if (c.IsNull() || c->NbPoles() != wall->num_u) continue;
+        ++profiles;
+        EXPECT_EQ(c->Degree(), 3);
+        for (int k = 0; k <= 20; ++k) {
+            const gp_Pnt p = c->Value(t0 + (t1 - t0) * k / 20);
+            const Vec3 q{p.X(), p.Y(), p.Z()};
+            EXPECT_LT(distance(surfaces[0].surface, q), 1e-9);
+            EXPECT_LT(std::min(std::abs(q.z), std::abs(q.z - kHeight)), 1e-9);
+        }
+    }
+    EXPECT_EQ(profiles, 2);
 }
 
 }  // namespace

@@ -554,9 +554,44 @@ bool strays_from(const ChainCurve& c, const std::vector<gp_Pnt>& points, double 
 
 // The intersection branch of `a` and `b` along `points`, within `accept` of all of them:
 // analytic for elementary pairs, else OpenCASCADE's general surface intersection.
+// Where a plane crosses a linear extrusion of a B-spline profile (fit_bspline()'s extrusions:
+// num_v 4, each row the profile moved along one line): exactly the profile moved along the
+// extrusion onto the plane — the same knots, each pole projected along the direction — since
+// the extrusion is P(u) + t e and the plane's equation fixes t as an affine function of P(u).
+// Null unless one surface is a plane and the other such an extrusion, crossing at more than
+// kTangentAngle (nearer parallel, the projection blows up).
+Handle(Geom_Curve) plane_extrusion_curve(const Surface& a, const Surface& b) {
+    const Surface* plane = a.kind == FitKind::kPlane   ? &a
+                           : b.kind == FitKind::kPlane ? &b
+                                                       : nullptr;
+    const Surface* ext = plane == &a ? &b : &a;
+    if (!plane || ext->kind != FitKind::kBSpline || !ext->bspline || !ext->bspline->extruded)
+        return {};
+    const BSplineSurface& bs = *ext->bspline;
+    if (bs.num_v < 2 || bs.num_u <= bs.degree) return {};
+    const Vec3 along = bs.poles[static_cast<std::size_t>(bs.num_u * (bs.num_v - 1))] - bs.poles[0];
+    if (!(norm(along) > 0)) return {};
+    const Vec3 e = normalized(along), n = plane->axis;
+    const double ne = dot(n, e);
+    if (!(std::abs(ne) > std::sin(kTangentAngle))) return {};
+    TColgp_Array1OfPnt poles(1, bs.num_u);
+    for (int i = 0; i < bs.num_u; ++i) {
+        const Vec3 p = bs.poles[static_cast<std::size_t>(i)];
+        poles.SetValue(i + 1, pnt(p + (dot(n, plane->point - p) / ne) * e));
+    }
+    const int spans = bs.num_u - bs.degree;
+    TColStd_Array1OfReal knots(1, spans + 1);
+    TColStd_Array1OfInteger mults(1, spans + 1);
+    for (int i = 0; i <= spans; ++i) {
+        knots.SetValue(i + 1, static_cast<double>(i) / spans);
+        mults.SetValue(i + 1, (i == 0 || i == spans) ? bs.degree + 1 : 1);
+    }
+    return new Geom_BSplineCurve(poles, knots, mults, bs.degree);
+}
+
 bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surface) & b,
-                        const std::vector<gp_Pnt>& points, bool closed, double accept,
-                        ChainCurve& out, bool& analytic) {
+                        const Surface& sa, const Surface& sb, const std::vector<gp_Pnt>& points,
+                        bool closed, double accept, ChainCurve& out, bool& analytic) {
     const std::vector<gp_Pnt> samples = chain_samples(points);
     const auto best_of = [&](const std::vector<Handle(Geom_Curve)>& lines) {
         bool found = false;
@@ -575,6 +610,8 @@ bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surfac
     };
     analytic = true;
     if (best_of(analytic_intersection(a, b))) return true;
+    if (const Handle(Geom_Curve) c = plane_extrusion_curve(sa, sb); !c.IsNull() && best_of({c}))
+        return true;
     analytic = false;
     GeomAPI_IntSS inter(a, b, Precision::Confusion());
     if (!inter.IsDone()) return false;
@@ -1178,7 +1215,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             try {
                 if (!tangent) {
                     bool analytic = false;
-                    ok = intersection_curve(geom[ra], geom[rb], pts, ch.closed,
+                    ok = intersection_curve(geom[ra], geom[rb], sa, sb, pts, ch.closed,
                                             opt.chordal_deflection + opt.tolerance, cc, analytic);
                     intersected = ok;
                     job.analytic = ok && analytic;

@@ -78,7 +78,8 @@ struct SurfaceBrep {
     /// fallback).
     std::uint64_t intersection_edges = 0, tangency_edges = 0, fitted_edges = 0, polyline_edges = 0;
     /// Of the intersection edges, those whose curve is exact (IntAna: a line, circle or
-    /// ellipse where two elementary surfaces meet).
+    /// ellipse where two elementary surfaces meet; a B-spline extrusion's profile moved onto a
+    /// plane).
     std::uint64_t analytic_edges = 0;
     std::uint64_t corners = 0;
     /// Of those, the corners put on the contact curve of two tangent surfaces.
