@@ -129,7 +129,7 @@ TEST(SurfaceBrep, LaterRoundsKeepWhatTheirChangeLeavesAlone) {
               b.fresh.corners_solved / static_cast<std::uint64_t>(b.fresh.rounds) + 4);
 }
 
-// A real part whose first shell fails the check (the M8 screw's thread flanks: B-splines whose
+// A real part whose first shell fails the check (the screw's thread flanks: B-splines whose
 // edges with their neighbours do not close it): its faces are built in two rounds, and the
 // faces of the second made from the same as in the first are not checked again.
 TEST(SurfaceBrep, FacesMadeFromTheSameAreNotCheckedAgain) {

@@ -832,9 +832,11 @@ struct Builder {
 // How a chain's edge was made (the report's edges by curve).
 enum class ChainKind : std::uint8_t { kIntersection, kTangency, kFitted };
 
-// A chain's curve to make (build_surface_brep()): its end points, and the result.
+// A chain's curve to make (build_surface_brep()): its regions' states and end points (what
+// GeometryCache::Chain keys on), and the result.
 struct CurveJob {
     std::size_t chain = 0;
+    std::array<std::uint8_t, 4> state{};
     gp_Pnt p0, p1;
     ChainCurve cc;
     bool ok = false, intersected = false, touched = false, analytic = false;
@@ -1281,7 +1283,6 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         // The curves to make this round (the chains between two surfaces whose curve is not kept
         // from the round before), made in parallel; their corners solved first.
         std::vector<CurveJob> jobs;
-        std::vector<std::size_t> job_of(borders.chains.size(), 0);
         for (std::size_t c = 0; c < borders.chains.size(); ++c) {
             const BorderChain& ch = borders.chains[c];
             if (ch.right < 0) continue;
@@ -1298,14 +1299,32 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 kept.p1.IsEqual(p1, 0)) {
                 continue;
             }
-            job_of[c] = jobs.size();
             CurveJob job;
             job.chain = c;
+            job.state = state;
             job.p0 = p0;
             job.p1 = p1;
             jobs.push_back(std::move(job));
         }
         tbb::parallel_for(std::size_t{0}, jobs.size(), [&](std::size_t j) { make_curve(jobs[j]); });
+        // Kept for the next round: every chain between two surfaces now has this round's curve
+        // (or its failure) in the cache.
+        for (CurveJob& job : jobs) {
+            GeometryCache::Chain& kept = cache.chains[job.chain];
+            kept = GeometryCache::Chain{};
+            ++out.curves_made;
+            kept.state = job.state;
+            kept.p0 = job.p0;
+            kept.p1 = job.p1;
+            if (!job.ok) continue;
+            kept.valid = true;
+            kept.id = cache.next_id++;
+            kept.curve = std::move(job.cc);
+            kept.kind = job.intersected ? ChainKind::kIntersection
+                        : job.touched   ? ChainKind::kTangency
+                                        : ChainKind::kFitted;
+            kept.analytic = job.analytic;
+        }
         std::vector<std::int32_t> failed_chain;
         for (std::size_t c = 0; c < borders.chains.size(); ++c) {
             const BorderChain& ch = borders.chains[c];
@@ -1317,44 +1336,15 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             if (!polyline) {
                 const TopoDS_Vertex V0 = solved_vertex(v0);
                 const TopoDS_Vertex V1 = ch.closed ? V0 : solved_vertex(v1);
-                GeometryCache::Chain& kept = cache.chains[c];
-                const std::array<std::uint8_t, 4> state{fallback[ra], fallback[rb], linear[ra],
-                                                        linear[rb]};
-                const gp_Pnt p0 = BRep_Tool::Pnt(V0), p1 = BRep_Tool::Pnt(V1);
+                // The curve made above, or kept from the round before: a copy (this round's
+                // fixes may change its edge's).
+                const GeometryCache::Chain& kept = cache.chains[c];
+                bool ok = kept.valid;
                 ChainCurve cc;
-                bool ok = false, intersected = false, touched = false;
-                if (opt.reuse_geometry && kept.valid && kept.state == state &&
-                    kept.p0.IsEqual(p0, 0) && kept.p1.IsEqual(p1, 0)) {
-                    // The curve of the round before (a copy: this round's fixes may change its
-                    // edge's).
+                if (ok) {
                     cc = kept.curve;
                     cc.curve = Handle(Geom_Curve)::DownCast(kept.curve.curve->Copy());
-                    ok = true;
-                    intersected = kept.kind == ChainKind::kIntersection;
-                    touched = kept.kind == ChainKind::kTangency;
                     if (kept.analytic) ++out.analytic_edges;
-                } else {
-                    kept = GeometryCache::Chain{};
-                    ++out.curves_made;
-                    kept.state = state;
-                    kept.p0 = p0;
-                    kept.p1 = p1;
-                    const CurveJob& job = jobs[job_of[c]];
-                    cc = job.cc;
-                    ok = job.ok;
-                    intersected = job.intersected;
-                    touched = job.touched;
-                    kept.analytic = job.analytic;
-                    if (ok) {
-                        kept.valid = true;
-                        kept.id = cache.next_id++;
-                        kept.curve = cc;
-                        kept.curve.curve = Handle(Geom_Curve)::DownCast(cc.curve->Copy());
-                        kept.kind = intersected ? ChainKind::kIntersection
-                                    : touched   ? ChainKind::kTangency
-                                                : ChainKind::kFitted;
-                        if (kept.analytic) ++out.analytic_edges;
-                    }
                 }
                 try {
                     if (ok) {
@@ -1370,16 +1360,16 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                             TopoDS_Edge e = me.Edge();
                             B.UpdateEdge(e, std::max(kMinTolerance, 1.01 * cc.deviation));
                             chain_edges[c].push_back(e);
-                            ++(intersected ? out.intersection_edges
-                               : touched   ? out.tangency_edges
-                                           : out.fitted_edges);
+                            ++(kept.kind == ChainKind::kIntersection ? out.intersection_edges
+                               : kept.kind == ChainKind::kTangency   ? out.tangency_edges
+                                                                     : out.fitted_edges);
                         }
                     }
                 } catch (const Standard_Failure&) {
                     ok = false;
                 }
                 if (ok) {
-                    chain_id[c] = cache.chains[c].id;
+                    chain_id[c] = kept.id;
                     continue;
                 }
                 failed_chain.push_back(static_cast<std::int32_t>(c));
