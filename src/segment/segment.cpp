@@ -94,6 +94,8 @@ constexpr double kNoiseFactor = 6;
 constexpr int kNoisePasses = 3;
 /// Facets of each region that order the merge queue (see unlikeness()).
 constexpr std::size_t kLikenessSamples = 1024;
+/// The merge queue's lower bounds take every kLikenessBoundThin-th of those (merge_regions()).
+constexpr std::size_t kLikenessBoundThin = 32;
 /// Regions of at most this many facets are dissolved into their neighbours when these fit them.
 constexpr std::size_t kSmallRegion = 8;
 /// Rounds of border refinement (each moves facets one row at most).
@@ -542,12 +544,14 @@ std::vector<std::uint32_t> region_of_faces(const Mesh& m, const std::vector<Draf
 }
 
 /// How alike two regions are (smaller: more alike): the largest distance of one's vertices to
-/// the other's surface, the smaller of the two ways.
-double unlikeness(const Context& c, const Draft& a, const Draft& b) {
+/// the other's surface, the smaller of the two ways. With `thin` > 1, from every thin-th of
+/// those facets only: a lower bound of the whole (a maximum over some of the same points).
+double unlikeness(const Context& c, const Draft& a, const Draft& b, std::size_t thin = 1) {
     // At most kLikenessSamples facets of each, evenly strided: an order, not a test.
     const auto worst = [&](const Draft& from, const Surface& to) {
         double w = 0;
-        const std::size_t step = std::max<std::size_t>(1, from.faces.size() / kLikenessSamples);
+        const std::size_t step =
+            std::max<std::size_t>(1, from.faces.size() / kLikenessSamples) * thin;
         for (std::size_t k = 0; k < from.faces.size(); k += step)
             for (int i = 0; i < 3; ++i)
                 w = std::max(w, distance(to, c.m.position(c.m.vertex(fid(from.faces[k]), i))));
@@ -567,23 +571,35 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
     std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
     for (const auto& [a, b] : pairs) nbrs[a].push_back(b), nbrs[b].push_back(a);
     std::vector<std::uint32_t> version(drafts.size(), 0);
-    using Item = std::tuple<double, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>;
+    // (cost, a, b, their versions, whether the cost is exact or a lower bound).
+    using Item =
+        std::tuple<double, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t, bool>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> pq;
     const auto mergeable = [&](std::uint32_t a) {
         return drafts[a].alive && drafts[a].surface_index < 0 &&
                drafts[a].surface.kind != FitKind::kBSpline;
     };
+    // A merge changes its region's pairs with all its neighbours, and a large region merges
+    // many times before most of them come up: a pair is queued by a lower bound of its cost
+    // (kLikenessBoundThin), its exact cost taken when it first reaches the top. A pair is
+    // still taken only when no pair of smaller exact cost is left (all bounds behind it are
+    // no smaller), so the order, ties included, is that of exact costs throughout.
     const auto push = [&](std::uint32_t a, std::uint32_t b) {
         if (a > b) std::swap(a, b);
         if (!mergeable(a) || !mergeable(b)) return;
-        pq.emplace(unlikeness(c, drafts[a], drafts[b]), a, b, version[a], version[b]);
+        pq.emplace(unlikeness(c, drafts[a], drafts[b], kLikenessBoundThin), a, b, version[a],
+                   version[b], false);
     };
     for (const auto& [a, b] : pairs) push(a, b);
     std::uint64_t merges = 0;
     while (!pq.empty()) {
-        const auto [cost, a, b, va, vb] = pq.top();
+        const auto [cost, a, b, va, vb, exact] = pq.top();
         pq.pop();
         if (!drafts[a].alive || !drafts[b].alive || version[a] != va || version[b] != vb) continue;
+        if (!exact) {
+            pq.emplace(unlikeness(c, drafts[a], drafts[b]), a, b, va, vb, true);
+            continue;
+        }
         std::vector<std::uint32_t> faces = drafts[a].faces;
         faces.insert(faces.end(), drafts[b].faces.begin(), drafts[b].faces.end());
         // A much larger region keeps its kind (and may take a firm plane that is its chords: a
