@@ -259,11 +259,22 @@ bool trim_along(Handle(Geom_Curve) c, const std::vector<gp_Pnt>& points, bool cl
     std::vector<double> u;
     u.reserve(points.size());
     double dev = 0;
+    // A bounded curve's ends are candidates too: a point past an end has no normal projection
+    // there, and its nearest one may be far along (a solved corner just past the end of a
+    // fitted extrusion's profile would project mid-way and the curve look doubled back).
+    const double c0 = c->FirstParameter(), c1 = c->LastParameter();
+    const bool bounded = !periodic && !Precision::IsInfinite(c0) && !Precision::IsInfinite(c1);
+    const gp_Pnt end0 = bounded ? c->Value(c0) : gp_Pnt(), end1 = bounded ? c->Value(c1) : gp_Pnt();
     for (const gp_Pnt& p : points) {
         GeomAPI_ProjectPointOnCurve proj(p, c);
-        if (!proj.NbPoints()) return false;
-        double t = proj.LowerDistanceParameter();
-        dev = std::max(dev, proj.LowerDistance());
+        double t = 0, d = std::numeric_limits<double>::infinity();
+        if (proj.NbPoints() > 0) t = proj.LowerDistanceParameter(), d = proj.LowerDistance();
+        if (bounded) {
+            if (const double d0 = p.Distance(end0); d0 < d) t = c0, d = d0;
+            if (const double d1 = p.Distance(end1); d1 < d) t = c1, d = d1;
+        }
+        if (!std::isfinite(d)) return false;
+        dev = std::max(dev, d);
         if (periodic && !u.empty()) {
             while (t - u.back() > 0.5 * period) t -= period;
             while (u.back() - t > 0.5 * period) t += period;
