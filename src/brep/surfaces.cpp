@@ -74,6 +74,7 @@
 #include <cstdint>
 #include <map>
 #include <numbers>
+#include <tuple>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -933,9 +934,12 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     // Corners (mesh vertex ids) solved without it after a face or chain at them failed with it
     // (a corner moved along a coarse mesh's contact band can pass its chain's next point).
     std::unordered_set<std::uint32_t> plain_at;
+    // Regions whose facets changed since their geometry was made (all, at first; a region
+    // absorbed and its absorber after try_absorb()).
+    std::vector<std::uint8_t> reshaped(nr, 1);
     const auto compute_geometry = [&] {
         for (std::size_t r = 0; r < nr; ++r) {
-            if (absorbed[r] >= 0 || fallback[r]) continue;
+            if (absorbed[r] >= 0 || fallback[r] || !reshaped[r]) continue;
             if (r < opt.facets_only.size() && !opt.facets_only[r].empty()) {
                 fall_back(r, opt.facets_only[r]);
                 continue;
@@ -962,6 +966,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         }
     };
     compute_geometry();
+    std::fill(reshaped.begin(), reshaped.end(), 0);
     // A failing region whose facets are all chords of a neighbour's surface (vertices within
     // twice the tolerance, middles within the chordal deflection, normals agreeing): a sliver
     // segmentation cut off a face (a strip along a fillet's tangent line, an island). It joins
@@ -1009,6 +1014,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             if (labels[FaceId(f)] == static_cast<std::int32_t>(r)) labels[FaceId(f)] = best;
         }
         absorbed[r] = best;
+        reshaped[r] = reshaped[static_cast<std::size_t>(best)] = 1;
         return true;
     };
     // A fallback region that is not built from its facets: one face on its surface bounded by
@@ -1030,11 +1036,42 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         return !geom[r].IsNull();
     };
     GeometryCache cache;
-    // After absorbing: borders, loops and the neighbours' geometry again (nothing kept).
+    // After absorbing: borders and loops again, and the geometry of the regions whose facets
+    // changed (a surface's seam is put away from its region's centroid). The cache keeps the
+    // chains that are still there, between regions that did not change, under their new
+    // indices; faces and corners are keyed by what they are made from, so only those
+    // around the change are made again.
     const auto relabelled = [&] {
+        std::vector<BorderChain> before = std::move(bd.borders.chains);
         bd.prepare();
         compute_geometry();
-        cache = GeometryCache{};
+        std::map<std::tuple<std::int32_t, std::int32_t, std::uint32_t, std::uint32_t>,
+                 std::vector<std::size_t>>
+            old_chain;
+        for (std::size_t c = 0; c < before.size() && c < cache.chains.size(); ++c) {
+            const BorderChain& ch = before[c];
+            if (reshaped[static_cast<std::size_t>(ch.left)] ||
+                (ch.right >= 0 && reshaped[static_cast<std::size_t>(ch.right)]))
+                continue;
+            old_chain[{ch.left, ch.right, ch.vertices.front().idx(), ch.vertices.back().idx()}]
+                .push_back(c);
+        }
+        std::vector<GeometryCache::Chain> chains(bd.borders.chains.size());
+        for (std::size_t c = 0; c < chains.size(); ++c) {
+            const BorderChain& ch = bd.borders.chains[c];
+            const auto it = old_chain.find(
+                {ch.left, ch.right, ch.vertices.front().idx(), ch.vertices.back().idx()});
+            if (it == old_chain.end()) continue;
+            for (const std::size_t o : it->second) {
+                if (before[o].closed == ch.closed && before[o].vertices == ch.vertices) {
+                    chains[c] = std::move(cache.chains[o]);
+                    break;
+                }
+            }
+        }
+        cache.chains = std::move(chains);
+        if (!opt.reuse_geometry) cache = GeometryCache{};
+        std::fill(reshaped.begin(), reshaped.end(), 0);
     };
     if (!opt.allow_fallback) {
         for (std::size_t r = 0; r < nr; ++r) {
