@@ -1,5 +1,6 @@
 // The exact B-rep's build rounds (an internal module: src/brep).
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <BRepGProp.hxx>
 #include <BRep_Tool.hxx>
@@ -134,13 +135,17 @@ TEST(SurfaceBrep, LaterRoundsKeepWhatTheirChangeLeavesAlone) {
 // corners and faces away from it are kept under their new indices, not made again. What was
 // kept gives the B-rep solving everything again gives; and less than half of what solving
 // again makes after the first round is made.
-TEST(SurfaceBrep, AnAbsorbedRegionKeepsTheGeometryAwayFromIt) {
+Mesh fillet_block_18k() {
     SampleOptions so;
     so.with_step = false;
     so.deflection = 0.003;
     so.angular_deflection = 0.1;
     const SamplePart part = make_sample_part("fillet_chamfer_block", so).value();
-    const Mesh mesh = build_mesh(part.mesh).value().mesh;
+    return build_mesh(part.mesh).value().mesh;
+}
+
+TEST(SurfaceBrep, AnAbsorbedRegionKeepsTheGeometryAwayFromIt) {
+    const Mesh mesh = fillet_block_18k();
     const SegmentResult sr = segment(mesh).value();
     const Builds b = build_both(mesh, sr, region_surfaces(sr));
     expect_same(b, "fillet_chamfer_block");
@@ -153,6 +158,27 @@ TEST(SurfaceBrep, AnAbsorbedRegionKeepsTheGeometryAwayFromIt) {
     EXPECT_LT(b.kept.curves_made, chains + (b.fresh.curves_made - chains) / 2);
     const std::uint64_t corners = b.fresh.corners_solved / rounds;
     EXPECT_LT(b.kept.corners_solved, corners + (b.fresh.corners_solved - corners) / 2);
+}
+
+// Chains' curves and new faces' checks run in parallel; the B-rep is the same on one thread
+// (the fillet block above: faces failing, a region absorbed, three rounds).
+TEST(SurfaceBrep, SameBRepWhateverTheThreadCount) {
+    const Mesh mesh = fillet_block_18k();
+    const SegmentResult sr = segment(mesh).value();
+    SurfaceBrepOptions o;
+    o.tolerance = sr.tolerance;
+    o.chordal_deflection = std::max(sr.chordal_deflection, sr.tolerance);
+    o.mesh_deflection = 0.5 * o.chordal_deflection;
+    Builds b;
+    b.kept = brep_detail::build_surface_brep(mesh, sr.region, region_surfaces(sr), o);
+    {
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        b.fresh = brep_detail::build_surface_brep(mesh, sr.region, region_surfaces(sr), o);
+    }
+    expect_same(b, "fillet_chamfer_block, one thread");
+    EXPECT_EQ(b.kept.curves_made, b.fresh.curves_made);
+    EXPECT_EQ(b.kept.faces_checked, b.fresh.faces_checked);
+    EXPECT_EQ(volume(b.kept), volume(b.fresh));
 }
 
 // A real part whose first shell fails the check (the screw's thread flanks: B-splines whose

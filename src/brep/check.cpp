@@ -10,8 +10,9 @@
 
 namespace ncrev::brep_detail {
 
-std::string check_failure(const TopoDS_Shape& shape, std::vector<TopoDS_Shape>* bad) {
-    BRepCheck_Analyzer check(shape);
+std::string check_failure(const TopoDS_Shape& shape, std::vector<TopoDS_Shape>* bad,
+                          bool parallel) {
+    BRepCheck_Analyzer check(shape, Standard_True, parallel ? Standard_True : Standard_False);
     if (check.IsValid()) return {};
     std::string out;
     for (TopAbs_ShapeEnum type :

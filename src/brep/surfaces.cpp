@@ -21,6 +21,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <BRepBuilderAPI_Copy.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepLib.hxx>
@@ -1499,6 +1500,14 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         std::vector<std::vector<TopoDS_Face>> faces(nr);
         cache.faces.resize(nr);
         std::vector<std::pair<std::size_t, std::string>> failed_region;
+        // A new face to check: its region, a copy of it as built, what it is made from.
+        struct FaceCheck {
+            std::size_t region = 0;
+            TopoDS_Face copy;
+            GeometryCache::Face made;
+            std::string failure;
+        };
+        std::vector<FaceCheck> to_check;
         // A surface face that fails is retried or falls back (below); a fallback region's face
         // bounded by its mesh edges that fails leaves the region as its facets.
         const auto face_failed = [&](std::size_t r, std::string why) {
@@ -1595,30 +1604,52 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     }
                 }
                 if (sense[r] < 0) F.Reverse();
-                if (!checked) ++out.faces_checked;
-                if (std::string why = checked ? std::string() : check_failure(F); !why.empty()) {
-                    face_failed(r, "its face fails OpenCASCADE's check (" + why + ")");
-                    continue;
-                }
-                if (opt.mesh_deflection > 0 && !checked) {
-                    BRepMesh_IncrementalMesh(F, opt.mesh_deflection, false, 0.2, false);
-                    TopLoc_Location loc;
-                    if (BRep_Tool::Triangulation(F, loc).IsNull()) {
-                        face_failed(r, std::string(kUntriangulated));
-                        continue;
-                    }
-                    // Not kept: neighbours' fixes may still replace its edges, which would
-                    // leave the triangulation's edge polygons stale.
-                    BRepTools::Clean(F);
-                }
                 faces[r].push_back(F);
                 made.valid = true;
-                cache.faces[r] = std::move(made);
+                if (checked) {
+                    cache.faces[r] = std::move(made);
+                    continue;
+                }
+                // Checked below, as it is now: later faces' fixes change shared edges in place.
+                ++out.faces_checked;
+                to_check.push_back(
+                    {r, TopoDS::Face(BRepBuilderAPI_Copy(F).Shape()), std::move(made), {}});
             } catch (const Standard_Failure& f) {
                 face_failed(
                     r, std::string("OpenCASCADE fails building its face: ") + f.GetMessageString());
             }
         }
+        // The new faces' checks (OpenCASCADE's; BRepMesh can triangulate it), each on its own
+        // copy, in parallel; failures taken in region order, as one after the other would be.
+        tbb::parallel_for(std::size_t{0}, to_check.size(), [&](std::size_t i) {
+            FaceCheck& fc = to_check[i];
+            try {
+                if (std::string why = check_failure(fc.copy); !why.empty()) {
+                    fc.failure = "its face fails OpenCASCADE's check (" + why + ")";
+                    return;
+                }
+                if (opt.mesh_deflection > 0) {
+                    BRepMesh_IncrementalMesh(fc.copy, opt.mesh_deflection, false, 0.2, false);
+                    TopLoc_Location loc;
+                    if (BRep_Tool::Triangulation(fc.copy, loc).IsNull()) {
+                        fc.failure = kUntriangulated;
+                    }
+                }
+            } catch (const Standard_Failure& f) {
+                fc.failure =
+                    std::string("OpenCASCADE fails building its face: ") + f.GetMessageString();
+            }
+        });
+        for (FaceCheck& fc : to_check) {
+            if (fc.failure.empty()) {
+                cache.faces[fc.region] = std::move(fc.made);
+                continue;
+            }
+            faces[fc.region].pop_back();
+            face_failed(fc.region, std::move(fc.failure));
+        }
+        std::stable_sort(failed_region.begin(), failed_region.end(),
+                         [](const auto& a, const auto& b) { return a.first < b.first; });
         // Facet faces of the fallback regions without a face of their own.
         for (std::uint32_t fi = 0; fi < m.num_faces(); ++fi) {
             const FaceId f(fi);
@@ -1751,7 +1782,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         out.shape = result;
         out.solid = closed;
         std::vector<TopoDS_Shape> bad = open_faces;
-        const std::string why = closed ? check_failure(result, &bad)
+        const std::string why = closed ? check_failure(result, &bad, true)
                                        : std::string("the shell is not closed, or not orientable");
         out.valid = why.empty() && closed;
         if (!why.empty()) out.problem = closed ? "BRepCheck_Analyzer: " + why : why;
