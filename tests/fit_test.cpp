@@ -589,6 +589,30 @@ TEST(FitBSpline, FreeFormPatchWithinToleranceAndChosenLast) {
     }
 }
 
+// A caller that takes no net of more than max_net_poles poles: the fit tries none larger, and
+// fails where the net it needs is larger (the die's bumps at a tenth of the tolerance above).
+TEST(FitBSpline, NoNetLargerThanTheCallerTakes) {
+    test::Rng rng(33);
+    const Patch p = freeform_patch(rng, 5000);
+    const double tol = 1e-4 * p.size;
+    FitInput in{p.points, p.normals, {}};
+    const FitResult free = fit_bspline(in, tol);
+    ASSERT_TRUE(free.ok) << free.failure;
+    const int poles = free.surface.bspline->num_u * free.surface.bspline->num_v;
+    ASSERT_GT(poles, 16);
+    in.max_net_poles = poles;  // what it needs: the same fit
+    const FitResult enough = fit_bspline(in, tol);
+    ASSERT_TRUE(enough.ok) << enough.failure;
+    EXPECT_EQ(enough.surface.bspline->poles.size(), free.surface.bspline->poles.size());
+    EXPECT_EQ(enough.max, free.max);
+    in.max_net_poles = poles - 1;  // less: the fit fails, with the largest net it may have
+    const FitResult capped = fit_bspline(in, tol);
+    EXPECT_FALSE(capped.ok);
+    ASSERT_TRUE(capped.surface.bspline);
+    EXPECT_LT(capped.surface.bspline->num_u * capped.surface.bspline->num_v, poles);
+    EXPECT_GT(capped.max, tol);
+}
+
 TEST(FitBSpline, PlanesStayPlanesAndNonHeightFieldsFail) {
     test::Rng rng(32);
     const Patch plane = plane_patch(rng, 2000);

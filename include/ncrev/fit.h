@@ -120,6 +120,8 @@ struct FitInput {
     /// When positive, a linear extrusion's profile has at most this many poles (a caller that
     /// would take no larger one spares the fits).
     int max_profile_poles = 0;
+    /// When positive, a net over the mean plane has at most this many poles (likewise).
+    int max_net_poles = 0;
 };
 
 /// The outcome of one fit: `ok` false when the points do not determine the surface (too few,

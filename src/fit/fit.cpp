@@ -1155,7 +1155,9 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
         const int nv = std::min(
             kBSplineMaxPoles,
             std::max(4, static_cast<int>(std::lround(base * std::max(1.0, 1.0 / aspect)))));
-        if (nu * nv > std::max(16, max_poles) || (nu == last_nu && nv == last_nv)) break;
+        if (nu * nv > std::max(16, max_poles) || (nu == last_nu && nv == last_nv) ||
+            (in.max_net_poles > 0 && nu * nv > in.max_net_poles))
+            break;
         last_nu = nu, last_nv = nv;
         const int m = nu * nv;
         // Normal equations in band storage: pole (a, b) couples with (a + da, b + db), |da|,

@@ -759,6 +759,8 @@ std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
         // ... and has fewer free parameters (2 per pole + 2) than they do.
         in.max_profile_poles = std::max(
             1, (static_cast<int>(std::min<std::size_t>(whole.parameters, 1u << 20)) - 3) / 2);
+        // A net is taken with at most kFreeformMaxPoles (below): none larger is fitted.
+        in.max_net_poles = kFreeformMaxPoles;
         FitResult r = fit_bspline(in, c.sag);
         if (!r.ok || r.max > c.sag ||
             r.surface.bspline->num_u * r.surface.bspline->num_v > kFreeformMaxPoles)
