@@ -281,6 +281,55 @@ TEST(Segment, FinelyMeshedFreeFormFaceIsOneBSpline) {
     EXPECT_GE(s.iou, 0.98) << s.worst;
 }
 
+// Every region of the fillet-and-chamfer block meshed finely (0.6 um, 0.05 rad: 80k facets) is
+// one piece, or its other pieces are larger than a few facets: border refinement leaves one-
+// and two-facet pieces where fillets meet (on the same part at 345k facets, dozens — each a
+// face of its own in the B-rep, too small to build), and those go to their neighbours.
+TEST(Segment, NoRegionKeepsATinyDetachedPiece) {
+    SampleOptions so;
+    so.with_step = false;
+    so.deflection = 0.0006;
+    so.angular_deflection = 0.05;
+    const SamplePart part = make_sample_part("fillet_chamfer_block", so).value();
+    const Mesh mesh = build_mesh(part.mesh).value().mesh;
+    const SegmentResult sr = segment(mesh).value();
+    // Pieces: components of each region across shared edges.
+    const std::size_t nf = mesh.num_faces();
+    std::vector<std::uint32_t> piece(nf, std::numeric_limits<std::uint32_t>::max());
+    std::vector<std::size_t> size;
+    std::map<std::int32_t, std::vector<std::size_t>> pieces_of;
+    for (std::uint32_t f0 = 0; f0 < nf; ++f0) {
+        if (piece[f0] != std::numeric_limits<std::uint32_t>::max()) continue;
+        const auto id = static_cast<std::uint32_t>(size.size());
+        size.push_back(0);
+        const std::int32_t r = sr.region[FaceId(f0)];
+        pieces_of[r].push_back(id);
+        std::vector<std::uint32_t> stack{f0};
+        piece[f0] = id;
+        while (!stack.empty()) {
+            const std::uint32_t f = stack.back();
+            stack.pop_back();
+            ++size[id];
+            for (int i = 0; i < 3; ++i) {
+                const HalfedgeId t = mesh.twin(Mesh::halfedge(FaceId(f), i));
+                if (!t.is_valid()) continue;
+                const std::uint32_t g = Mesh::face(t).idx();
+                if (sr.region[FaceId(g)] != r || piece[g] == id) continue;
+                piece[g] = id;
+                stack.push_back(g);
+            }
+        }
+    }
+    std::size_t tiny = 0;
+    for (const auto& [r, ids] : pieces_of) {
+        if (ids.size() < 2) continue;
+        std::size_t largest = 0;
+        for (const std::size_t id : ids) largest = std::max(largest, size[id]);
+        for (const std::size_t id : ids) tiny += size[id] != largest && size[id] <= 8;
+    }
+    EXPECT_EQ(tiny, 0u);
+}
+
 TEST(Segment, RejectsNonFiniteOptions) {
     const Case c = make_case("slot_plate", kFine);
     SegmentOptions o;

@@ -820,19 +820,65 @@ std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
 
 /// Small regions whose facets each fit a neighbouring region's surface are dissolved into
 /// them: the leftovers of growing where three faces meet (a facet of the fillet and one of the
-/// corner torus, coplanar within the tolerance, grown together as a plane). Returns the facets
-/// moved.
+/// corner torus, coplanar within the tolerance, grown together as a plane). So are a larger
+/// region's small detached pieces (all but its largest piece, of at most kSmallRegion facets):
+/// each piece becomes a face of its own in the B-rep, and on a fine mesh border refinement
+/// leaves dozens of one- or two-facet pieces where fillets meet, too small for a face.
+/// Returns the facets moved.
 std::uint64_t absorb_small_regions(Context& c, std::vector<Draft>& drafts) {
     std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
     std::uint64_t moved = 0;
     bool changed = true;
+    // Per facet, its piece (a component of its region across shared edges) this round.
+    std::vector<std::uint32_t> piece(c.m.num_faces(), kNone);
+    std::vector<std::uint32_t> stack, sizes;
     for (int round = 0; round < kRefineRounds && changed; ++round) {
         changed = false;
         for (std::uint32_t r = 0; r < drafts.size(); ++r) {
             Draft& d = drafts[r];
-            if (!d.alive || d.surface_index >= 0 || d.faces.size() > kSmallRegion) continue;
+            if (!d.alive || d.surface_index >= 0) continue;
+            // The facets to dissolve: all of a small region; a larger one's small pieces.
+            std::vector<std::uint8_t> loose(d.faces.size(), 0);
+            if (d.faces.size() <= kSmallRegion) {
+                std::fill(loose.begin(), loose.end(), 1);
+            } else {
+                sizes.clear();
+                for (const std::uint32_t f0 : d.faces) piece[f0] = kNone;
+                for (const std::uint32_t f0 : d.faces) {
+                    if (piece[f0] != kNone) continue;
+                    const auto id = static_cast<std::uint32_t>(sizes.size());
+                    sizes.push_back(0);
+                    piece[f0] = id;
+                    stack.assign(1, f0);
+                    while (!stack.empty()) {
+                        const std::uint32_t f = stack.back();
+                        stack.pop_back();
+                        ++sizes[id];
+                        for (const std::uint32_t g : c.fd.adj[f]) {
+                            if (g == kNone || region[g] != r || piece[g] != kNone) continue;
+                            piece[g] = id;
+                            stack.push_back(g);
+                        }
+                    }
+                }
+                if (sizes.size() < 2) continue;
+                const auto largest = static_cast<std::uint32_t>(
+                    std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+                bool any = false;
+                for (std::size_t k = 0; k < d.faces.size(); ++k) {
+                    const std::uint32_t p = piece[d.faces[k]];
+                    loose[k] = p != largest && sizes[p] <= kSmallRegion;
+                    any = any || loose[k];
+                }
+                if (!any) continue;
+            }
             std::vector<std::uint32_t> kept;
-            for (const std::uint32_t f : d.faces) {
+            for (std::size_t k = 0; k < d.faces.size(); ++k) {
+                const std::uint32_t f = d.faces[k];
+                if (!loose[k]) {
+                    kept.push_back(f);
+                    continue;
+                }
                 std::uint32_t best = kNone;
                 double best_cost = c.tol;
                 for (const std::uint32_t g : c.fd.adj[f]) {
