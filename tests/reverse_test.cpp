@@ -349,6 +349,24 @@ TEST(ReverseSurfaces, FallbackRegionsKeepTheirSurfaces) {
     }
 }
 
+// The M6 screw's thread (~270 regions of cones, tori and planes along a helix): the face of
+// its threaded core kept 11 of its 158 edges after ShapeFix_Face dropped a wire it found
+// outside the surface's bounds; that face passed its check, its neighbours' edges stayed
+// unpaired, 160 regions fell back one after the other and the whole part went planar (6217
+// faces). A face whose fix drops edges now fails like any other: a few regions fall back, the
+// rest keeps its surfaces, and the solid stays within 2 deflections of the mesh.
+TEST(ReverseSurfaces, AThreadedScrewIsNotBuiltWhollyPlanar) {
+    const auto path = corpus_step_dir() / "build123d_M6-1x12-countersunk-screw.step";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus at " << path;
+    const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "m6_screw");
+    expect_solid(o, "m6_screw");
+    for (const ReverseFallback& f : o.report.fallbacks) EXPECT_GE(f.region, 0) << f.reason;
+    EXPECT_LE(o.report.fallbacks.size(), 10u);
+    ASSERT_TRUE(o.report.deviation.has_value());
+    EXPECT_LE(o.report.deviation->mesh_to_solid.max, 2 * o.deflection);
+    EXPECT_LE(o.report.deviation->solid_to_mesh.max, 2 * o.deflection);
+}
+
 // A finer tessellation of a real part (NIST CTC 03 at 0.02 mm, 17k facets, as the benchmark
 // runs it): its fillet edges have many more chain points, and a corner solved a little past
 // the first of them used to fold the edge curve back on itself (self-intersecting wires, then

@@ -1046,6 +1046,11 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         std::vector<BorderChain> before = std::move(bd.borders.chains);
         bd.prepare();
         compute_geometry();
+        if (!opt.reuse_geometry) {
+            cache = GeometryCache{};
+            std::fill(reshaped.begin(), reshaped.end(), 0);
+            return;
+        }
         std::map<std::tuple<std::int32_t, std::int32_t, std::uint32_t, std::uint32_t>,
                  std::vector<std::size_t>>
             old_chain;
@@ -1071,7 +1076,6 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             }
         }
         cache.chains = std::move(chains);
-        if (!opt.reuse_geometry) cache = GeometryCache{};
         std::fill(reshaped.begin(), reshaped.end(), 0);
     };
     if (!opt.allow_fallback) {
@@ -1548,6 +1552,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     F = mf.Face();
                 } else {
                     B.MakeFace(F, geom[r], kMinTolerance);
+                    std::size_t wire_edges_in = 0;
                     for (const auto& loop : bd.loops[r]) {
                         // The loop, in the surface's own orientation.
                         std::vector<TopoDS_Edge> wire_edges;
@@ -1565,6 +1570,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                             std::reverse(wire_edges.begin(), wire_edges.end());
                             for (TopoDS_Edge& e : wire_edges) e.Reverse();
                         }
+                        wire_edges_in += wire_edges.size();
                         TopoDS_Wire W;
                         B.MakeWire(W);
                         for (const TopoDS_Edge& e : wire_edges) B.Add(W, e);
@@ -1601,6 +1607,18 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     // ranges and tolerances made consistent with their curves on the surface.
                     for (TopExp_Explorer x(F, TopAbs_EDGE); x.More(); x.Next()) {
                         ShapeFix_Edge().FixSameParameter(TopoDS::Edge(x.Current()));
+                    }
+                    // The fix may still drop a whole wire (one it finds outside the surface's
+                    // bounds): the face then passes its check and leaves its neighbours' edges
+                    // unpaired (the M6 screw's threaded cone kept 11 of its 158 edges, and the
+                    // part went planar). It adds seams and splits edges, but never has fewer.
+                    TopTools_IndexedMapOfShape kept_edges;
+                    TopExp::MapShapes(F, TopAbs_EDGE, kept_edges);
+                    if (static_cast<std::size_t>(kept_edges.Extent()) < wire_edges_in) {
+                        face_failed(r, "its face's fix dropped edges (" +
+                                           std::to_string(kept_edges.Extent()) + " of " +
+                                           std::to_string(wire_edges_in) + " left)");
+                        continue;
                     }
                 }
                 if (sense[r] < 0) F.Reverse();
