@@ -138,6 +138,19 @@ struct RegionShape {
     std::vector<FaceId> samples;  ///< facets spread over the region
 };
 
+// The knots of fit's B-splines (BSplineSurface), along a direction of `poles` poles: uniform
+// on [0, 1], clamped (the ends repeated degree + 1 times).
+void uniform_knots(int poles, int degree, TColStd_Array1OfReal& knots,
+                   TColStd_Array1OfInteger& mults) {
+    const int spans = poles - degree;
+    knots.Resize(1, spans + 1, false);
+    mults.Resize(1, spans + 1, false);
+    for (int i = 0; i <= spans; ++i) {
+        knots.SetValue(i + 1, static_cast<double>(i) / spans);
+        mults.SetValue(i + 1, (i == 0 || i == spans) ? degree + 1 : 1);
+    }
+}
+
 // The OpenCASCADE surface of `s`, its seam (or pole) put away from the region: the seam of a
 // cylinder, cone or torus opposite the region's centroid, a sphere's pole at the middle of the
 // region. Null (with `why`) when there is none.
@@ -191,19 +204,10 @@ Handle(Geom_Surface) geom_surface(const Surface& s, const RegionShape& r, std::s
                                    pnt(b.poles[static_cast<std::size_t>(i + b.num_u * j)]));
                 }
             }
-            const auto knots = [&](int n, TColStd_Array1OfReal& k, TColStd_Array1OfInteger& m) {
-                const int spans = n - b.degree;
-                k.Resize(1, spans + 1, false);
-                m.Resize(1, spans + 1, false);
-                for (int i = 0; i <= spans; ++i) {
-                    k.SetValue(i + 1, static_cast<double>(i) / spans);
-                    m.SetValue(i + 1, (i == 0 || i == spans) ? b.degree + 1 : 1);
-                }
-            };
             TColStd_Array1OfReal ku(1, 1), kv(1, 1);
             TColStd_Array1OfInteger mu(1, 1), mv(1, 1);
-            knots(b.num_u, ku, mu);
-            knots(b.num_v, kv, mv);
+            uniform_knots(b.num_u, b.degree, ku, mu);
+            uniform_knots(b.num_v, b.degree, kv, mv);
             return new Geom_BSplineSurface(poles, ku, kv, mu, mv, b.degree, b.degree);
         }
     }
@@ -592,13 +596,9 @@ Handle(Geom_Curve) plane_extrusion_curve(const Surface& a, const Surface& b) {
         const Vec3 p = bs.poles[static_cast<std::size_t>(i)];
         poles.SetValue(i + 1, pnt(p + (dot(n, plane->point - p) / ne) * e));
     }
-    const int spans = bs.num_u - bs.degree;
-    TColStd_Array1OfReal knots(1, spans + 1);
-    TColStd_Array1OfInteger mults(1, spans + 1);
-    for (int i = 0; i <= spans; ++i) {
-        knots.SetValue(i + 1, static_cast<double>(i) / spans);
-        mults.SetValue(i + 1, (i == 0 || i == spans) ? bs.degree + 1 : 1);
-    }
+    TColStd_Array1OfReal knots(1, 1);
+    TColStd_Array1OfInteger mults(1, 1);
+    uniform_knots(bs.num_u, bs.degree, knots, mults);
     return new Geom_BSplineCurve(poles, knots, mults, bs.degree);
 }
 
