@@ -829,5 +829,40 @@ TEST(FitSnap, ConeAnglesAndTorusRadii) {
     EXPECT_EQ(applied.size(), 2u);
 }
 
+// A turned dome whose meridian arc is centered across the axis (a screw head: radius 54.87,
+// 8.25 across) is the inner part of a spindle torus: a negative major radius. Its distances,
+// closest points and normals hold as for any torus.
+TEST(Fit, ATurnedDomeIsTheInnerPartOfASpindleTorus) {
+    test::Rng rng(5);
+    const double R = 8.25, r = 54.87;
+    Surface local;
+    local.kind = FitKind::kTorus;
+    local.radius = -R;
+    local.minor_radius = r;
+    // Half the dome (a slot splits it), from 0.5 to 7.7 off the axis.
+    // In the half-plane at azimuth a + pi: R + r cos b = -rho.
+    const double b0 = std::acos((-0.5 - R) / r), b1 = std::acos((-7.7 - R) / r);
+    const Patch p =
+        make_patch("dome", local, 2000, rng, [=](double u, double v, Vec3& q, Vec3& nq) {
+            const double a = kPi * u, b = b1 + (b0 - b1) * v;
+            nq = {std::cos(b) * std::cos(a), std::cos(b) * std::sin(a), std::sin(b)};
+            q = Vec3{R * std::cos(a), R * std::sin(a), 0} + r * nq;
+        });
+    const FitResult f = fit_patch(p);
+    ASSERT_TRUE(f.ok) << f.failure;
+    EXPECT_NEAR(f.surface.radius, -R, 1e-6 * R);
+    EXPECT_NEAR(f.surface.minor_radius, r, 1e-6 * r);
+    EXPECT_LE(f.max, 1e-6 * p.size);
+    // No sphere is near it.
+    const FitResult sphere = fit(FitKind::kSphere, FitInput{p.points, p.normals, {}});
+    EXPECT_GT(sphere.max, 1e-3 * p.size);
+    for (std::size_t i = 0; i < p.points.size(); i += 97) {
+        const Vec3 off = p.points[i] + 0.3 * p.normals[i];
+        EXPECT_NEAR(distance(f.surface, off), 0.3, 1e-6);
+        EXPECT_LE(norm(closest_point(f.surface, off) - p.points[i]), 1e-6);
+        EXPECT_GT(std::fabs(dot(normal_at(f.surface, p.points[i]), p.normals[i])), 1 - 1e-9);
+    }
+}
+
 }  // namespace
 }  // namespace ncrev

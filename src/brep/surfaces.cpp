@@ -173,9 +173,14 @@ Handle(Geom_Surface) geom_surface(const Surface& s, const RegionShape& r, std::s
             return new Geom_SphericalSurface(frame(s.point, pole, any_perpendicular(pole)),
                                              s.radius);
         }
-        case FitKind::kTorus:
-            return new Geom_ToroidalSurface(frame(s.point, axis, s.point - r.centroid), s.radius,
+        case FitKind::kTorus: {
+            // The inner part of a spindle torus (R < 0) is OpenCASCADE's torus (|R|, r) where
+            // R + r cos v < 0: a point of parameter u lies at azimuth u + pi, so the seam's
+            // x direction points at the centroid to fall opposite it.
+            const Vec3 away = s.radius < 0 ? r.centroid - s.point : s.point - r.centroid;
+            return new Geom_ToroidalSurface(frame(s.point, axis, away), std::fabs(s.radius),
                                             s.minor_radius);
+        }
         case FitKind::kShearCylinder:
         case FitKind::kSweptTorus: {
             const gp_Ax2 ax = frame(s.point, axis, any_perpendicular(axis)).Ax2();
@@ -433,7 +438,7 @@ bool spine_point(const Surface& s, Vec3 p, Vec3& c, double& radius) {
             return true;
         case FitKind::kTorus: {
             const Vec3 radial = perpendicular_part(p - s.point, axis);
-            if (norm(radial) <= 1e-12 * s.radius) return false;
+            if (norm(radial) <= 1e-12 * std::fabs(s.radius)) return false;
             c = s.point + s.radius * normalized(radial);
             radius = s.minor_radius;
             return true;

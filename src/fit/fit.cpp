@@ -140,6 +140,12 @@ constexpr double kRelativeDecrease = 1e-14;
 /// cylinder's points, a sphere to a plane's): stop refining and report no fit.
 constexpr double kRunaway = 1000.0;
 constexpr double kTorusRunaway = 100.0;
+/// The inner (lemon) part of a spindle torus is taken when its tube circle's center lies
+/// across the axis by less than this fraction of its radius: a turned dome's arc (the corpus
+/// screw head: 8.25 for a radius of 54.87, 0.15). Nearer 1 the lemon is a needle far longer
+/// than wide, which a thread flank's strip or a small patch near a fillet fits about any axis
+/// (0.82-0.96 on the corpus parts) without being one.
+constexpr double kLemonMaxAxisOffset = 0.5;
 /// B-splines: the first net (poles along the shorter side), the largest per direction, the
 /// weight of the smoothing term relative to the data (enough to bridge cells without points,
 /// far below what would bend the surface away from them), the default tolerance of fit() as a
@@ -1011,7 +1017,9 @@ FitResult fit_torus(const FitInput& in) {
     TorusModel m{Axis::make(c + h0 * d, d), R, std::sqrt(r2)};
     const int it = refine(m, in);
     FitResult res = finish(m, it, in);
-    if (res.ok && !(m.r > 0 && m.R > 0)) {
+    // A negative major radius is the inner part of a spindle torus (r > |R|): the lemon-shaped
+    // dome of a screw head, whose meridian arc is centered across the axis (kLemonMaxAxisOffset).
+    if (res.ok && !(m.r > 0 && (m.R > 0 || (-m.R > 0 && -m.R < kLemonMaxAxisOffset * m.r)))) {
         res.ok = false;
         res.failure = "the radii left their range";
     }
@@ -1915,7 +1923,7 @@ CommonPoint common_point(std::span<const Surface> surfaces, Vec3 start) {
     if (k == 0 || !finite(start)) return out;
     // Rounding level of the coordinates: the scale of the point and of the surfaces' anchors.
     double scale = norm(start);
-    for (const Surface& s : surfaces) scale = std::max(scale, norm(s.point) + s.radius);
+    for (const Surface& s : surfaces) scale = std::max(scale, norm(s.point) + std::fabs(s.radius));
     const double eps = 1e-14 * std::max(1.0, scale);
     Eigen::MatrixXd J(static_cast<Eigen::Index>(k), 3);
     Eigen::VectorXd r(static_cast<Eigen::Index>(k));
@@ -2148,7 +2156,9 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
         slots.push_back({&Surface::radius, 1u << 5, "major radius"});
     }
     for (const RadiusSlot& slot : slots) {
-        const double value = cur.surface.*(slot.field);
+        // A spindle torus's inner part has a negative major radius: its size is snapped.
+        const double signed_value = cur.surface.*(slot.field);
+        const double sign = signed_value < 0 ? -1.0 : 1.0, value = std::fabs(signed_value);
         std::vector<double> candidates;
         std::vector<double> tools = o.tool_radii;
         std::sort(tools.begin(), tools.end(),
@@ -2164,10 +2174,11 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
         for (double cand : candidates) {
             if (cand == value) break;  // already round
             Surface s = cur.surface;
-            s.*(slot.field) = cand;
+            s.*(slot.field) = sign * cand;
             const FitResult r = refit_surface(s, frozen | slot.bit, in);
             if (accept(r)) {
-                note(std::string(slot.name) + " " + number(value) + " -> " + number(cand));
+                note(std::string(slot.name) + " " + number(signed_value) + " -> " +
+                     number(sign * cand));
                 cur = r;
                 frozen |= slot.bit;
                 break;
