@@ -290,7 +290,10 @@ TEST(Reverse, ADomedHeadIsTheInnerPartOfASpindleTorus) {
     EXPECT_TRUE(back.valid);
     GProp_GProps props;
     BRepGProp::VolumeProperties(head, props);
-    EXPECT_NEAR(back.volume, props.Mass(), 1e-2 * props.Mass());
+    // The flat top is bounded by one closed fitted edge (IntAna has no lemon circles): its
+    // range began between knots, and OpenCASCADE's volume lost 4.3 mm3 (0.6 %) of the solid.
+    EXPECT_NEAR(rev->solid_volume, props.Mass(), 1e-4 * props.Mass());
+    EXPECT_NEAR(back.volume, props.Mass(), 1e-4 * props.Mass());
 }
 
 }  // namespace

@@ -298,6 +298,16 @@ bool trim_along(Handle(Geom_Curve) c, const std::vector<gp_Pnt>& points, bool cl
         // Unwrapped around once: the last point is the first one a period on.
         if (std::abs(std::abs(b - a) - period) > 0.25 * period) return false;
         b = a + (b > a ? period : -period);
+        // A closed edge's range starts at a knot: OpenCASCADE's integrals over a face
+        // (BRepGProp's volume, the NURBS conversion) lose part of a periodic B-spline whose
+        // range [a, a + period] begins between knots (a flat disc bounded by one came out with
+        // a third less volume).
+        if (const Handle(Geom_BSplineCurve) bs = Handle(Geom_BSplineCurve)::DownCast(c);
+            !bs.IsNull()) {
+            const Handle(Geom_BSplineCurve) copy = Handle(Geom_BSplineCurve)::DownCast(bs->Copy());
+            copy->SetOrigin(std::min(a, b), Precision::PConfusion());
+            c = copy;
+        }
     }
     if (a == b) return false;
     // Monotone along the chain (a curve that doubles back is the wrong branch).
