@@ -285,6 +285,9 @@ TEST(Reverse, ADomedHeadIsTheInnerPartOfASpindleTorus) {
     EXPECT_TRUE(rev->valid && rev->solid);
     EXPECT_TRUE(rev->fallbacks.empty());
     EXPECT_EQ(rev->faces, 4u);  // bottom, side, dome, flat top
+    // Its three circles exact: IntAna gives none on a lemon (coaxial_circles does).
+    EXPECT_EQ(rev->edges_by_curve["analytic"], 3u);
+    EXPECT_EQ(rev->edges_by_curve["fitted"], 0u);
     EXPECT_EQ(rev->faces_by_kind.count("torus") ? rev->faces_by_kind.at("torus") : 0u, 1u);
     const test::ReadBack back = test::read_step(path);
     EXPECT_TRUE(back.valid);

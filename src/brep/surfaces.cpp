@@ -71,6 +71,7 @@
 #include <TopoDS_Vertex.hxx>
 #include <TopoDS_Wire.hxx>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -617,6 +618,116 @@ Handle(Geom_Curve) plane_extrusion_curve(const Surface& a, const Surface& b) {
     return new Geom_BSplineCurve(poles, knots, mults, bs.degree);
 }
 
+// The meridian of a surface of revolution in the half-plane (rho >= 0, h) of an axis through
+// `o` along unit `d`: a line through (rho, h) along (drho, dh), or a circle of center (rho, h)
+// and `radius`. A torus's is its tube circle on the region's side (center at R, which is
+// negative for a lemon); a cone's the line of its nappe.
+struct Meridian {
+    bool circle = false;
+    double rho = 0, h = 0, drho = 0, dh = 0, radius = 0;
+};
+
+// Whether `s` is a surface of revolution about the axis (o, d), and its meridian. Axes fitted
+// separately differ by their noise; the circles are kept only where the chain's points lie
+// within the edge tolerance of them (intersection_curve), so this only spares the work.
+bool meridian_about(const Surface& s, Vec3 o, Vec3 d, double scale, Meridian& m) {
+    constexpr double kCoaxial = 1e-4;
+    const Vec3 axis = normalized(s.axis);
+    const bool parallel = norm(cross(axis, d)) <= kCoaxial;
+    const auto on_axis = [&](Vec3 p) {
+        const Vec3 w = p - o;
+        return norm(w - dot(w, d) * d) <= kCoaxial * scale;
+    };
+    const double h = dot(s.point - o, d);
+    switch (s.kind) {
+        case FitKind::kPlane:
+            if (!parallel) return false;
+            m = {false, 0, h, 1, 0, 0};
+            return true;
+        case FitKind::kCylinder:
+            if (!parallel || !on_axis(s.point)) return false;
+            m = {false, s.radius, 0, 0, 1, 0};
+            return true;
+        case FitKind::kCone: {
+            if (!parallel || !on_axis(s.point)) return false;
+            const double grow = dot(axis, d) > 0 ? std::tan(s.angle) : -std::tan(s.angle);
+            m = {false, s.radius, h, grow, 1, 0};
+            return true;
+        }
+        case FitKind::kSphere:
+            if (!on_axis(s.point)) return false;
+            m = {true, 0, h, 0, 0, s.radius};
+            return true;
+        case FitKind::kTorus:
+            if (!parallel || !on_axis(s.point)) return false;
+            m = {true, s.radius, h, 0, 0, s.minor_radius};
+            return true;
+        default:
+            return false;
+    }
+}
+
+// Where two coaxial surfaces of revolution meet: circles about their axis, one per crossing
+// of their meridians off the axis. IntAna's answers assume a torus's tube circle on the
+// surface's side of the axis and give none on the inner part of a spindle torus (a domed
+// head meeting its flat top or its side); empty when the pair is not coaxial or its meridians
+// do not cross.
+std::vector<Handle(Geom_Curve)> coaxial_circles(const Surface& a, const Surface& b) {
+    const Surface* ref =
+        a.kind == FitKind::kCylinder || a.kind == FitKind::kCone || a.kind == FitKind::kTorus ? &a
+                                                                                              : &b;
+    if (ref->kind != FitKind::kCylinder && ref->kind != FitKind::kCone &&
+        ref->kind != FitKind::kTorus)
+        return {};
+    const Vec3 o = ref->point, d = normalized(ref->axis);
+    const double scale = std::max({norm(a.point - o), norm(b.point - o), std::fabs(a.radius),
+                                   std::fabs(b.radius), a.minor_radius, b.minor_radius, 1.0});
+    Meridian ma, mb;
+    if (!meridian_about(a, o, d, scale, ma) || !meridian_about(b, o, d, scale, mb)) {
+        return {};
+    }
+    if (ma.circle && !mb.circle) std::swap(ma, mb);
+    std::vector<std::array<double, 2>> hits;  // (rho, h)
+    if (!ma.circle && !mb.circle) {
+        // Lines: p_a + s u_a = p_b + t u_b.
+        const double det = ma.drho * (-mb.dh) - ma.dh * (-mb.drho);
+        if (std::fabs(det) <= 1e-12 * std::hypot(ma.drho, ma.dh) * std::hypot(mb.drho, mb.dh))
+            return {};
+        const double rx = mb.rho - ma.rho, ry = mb.h - ma.h;
+        const double t = (rx * (-mb.dh) - ry * (-mb.drho)) / det;
+        hits.push_back({ma.rho + t * ma.drho, ma.h + t * ma.dh});
+    } else if (!ma.circle) {
+        // Line and circle: |p + t u - c|^2 = r^2.
+        const double ul = std::hypot(ma.drho, ma.dh);
+        const double ux = ma.drho / ul, uy = ma.dh / ul;
+        const double wx = ma.rho - mb.rho, wy = ma.h - mb.h;
+        const double bq = wx * ux + wy * uy, cq = wx * wx + wy * wy - mb.radius * mb.radius;
+        const double disc = bq * bq - cq;
+        if (disc < 0) return {};
+        for (const double t : {-bq - std::sqrt(disc), -bq + std::sqrt(disc)})
+            hits.push_back({ma.rho + t * ux, ma.h + t * uy});
+    } else {
+        // Circles: the radical line, then the chord's half-length.
+        const double dx = mb.rho - ma.rho, dy = mb.h - ma.h, dist = std::hypot(dx, dy);
+        if (!(dist > 0)) return {};
+        const double along =
+            (dist * dist + ma.radius * ma.radius - mb.radius * mb.radius) / (2 * dist);
+        const double half2 = ma.radius * ma.radius - along * along;
+        if (half2 < 0) return {};
+        const double half = std::sqrt(half2), ex = dx / dist, ey = dy / dist;
+        const double mx = ma.rho + along * ex, my = ma.h + along * ey;
+        hits.push_back({mx - half * ey, my + half * ex});
+        hits.push_back({mx + half * ey, my - half * ex});
+    }
+    std::vector<Handle(Geom_Curve)> out;
+    for (const auto& [rho, h] : hits) {
+        if (!(rho > kMinTolerance) || !std::isfinite(h)) continue;
+        const Vec3 c = o + h * d;
+        out.push_back(new Geom_Circle(gp_Ax2(pnt(c), gp_Dir(d.x, d.y, d.z)), rho));
+    }
+    return out;
+}
+
 bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surface) & b,
                         const Surface& sa, const Surface& sb, const std::vector<gp_Pnt>& points,
                         bool closed, double accept, ChainCurve& out, bool& analytic) {
@@ -640,6 +751,7 @@ bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surfac
     if (best_of(analytic_intersection(a, b))) return true;
     if (const Handle(Geom_Curve) c = plane_extrusion_curve(sa, sb); !c.IsNull() && best_of({c}))
         return true;
+    if (best_of(coaxial_circles(sa, sb))) return true;
     analytic = false;
     GeomAPI_IntSS inter(a, b, Precision::Confusion());
     if (!inter.IsDone()) return false;
