@@ -613,6 +613,26 @@ TEST(FitBSpline, NoNetLargerThanTheCallerTakes) {
     EXPECT_GT(capped.max, tol);
 }
 
+// A long thin strip (a cone's row of facets along a slot, 24 times longer than wide, sampled by
+// 210 points): its first net, 4 poles across and 4 x 24 along, had more poles than half its
+// points, so no net was tried and the fit failed ("singular"); it starts with as many poles
+// along as the points allow.
+TEST(FitBSpline, ALongThinStripFits) {
+    test::Rng rng(35);
+    std::vector<Vec3> points, normals;
+    for (int i = 0; i < 210; ++i) {
+        const double x = 96 * rng.uniform(), y = 4 * rng.uniform();
+        const double z = 0.5 * std::sin(x / 15) + 0.02 * y * y;
+        points.push_back({x, y, z});
+        normals.push_back(normalized(Vec3{-0.5 / 15 * std::cos(x / 15), -0.04 * y, 1}));
+    }
+    const double tol = 1e-3 * 96;
+    const FitResult r = fit_bspline(FitInput{points, normals, {}}, tol);
+    ASSERT_TRUE(r.ok) << r.failure;
+    EXPECT_LE(r.max, tol);
+    EXPECT_LE(r.surface.bspline->num_u * r.surface.bspline->num_v, 105);
+}
+
 TEST(FitBSpline, PlanesStayPlanesAndNonHeightFieldsFail) {
     test::Rng rng(32);
     const Patch plane = plane_patch(rng, 2000);

@@ -1157,12 +1157,20 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
     FitResult best = fail;
     int last_nu = 0, last_nv = 0;  // the net stops growing at kBSplineMaxPoles
     for (;;) {
-        const int nu =
-            std::min(kBSplineMaxPoles,
-                     std::max(4, static_cast<int>(std::lround(base * std::max(1.0, aspect)))));
-        const int nv = std::min(
+        int nu = std::min(kBSplineMaxPoles,
+                          std::max(4, static_cast<int>(std::lround(base * std::max(1.0, aspect)))));
+        int nv = std::min(
             kBSplineMaxPoles,
             std::max(4, static_cast<int>(std::lround(base * std::max(1.0, 1.0 / aspect)))));
+        // A long strip's first net: as many poles along it as the points allow (its 4 x 24
+        // proportional net would have more poles than half its points and no net be tried).
+        if (last_nu == 0 && nu * nv > std::max(16, max_poles)) {
+            if (nu > nv) {
+                nu = std::max(4, std::max(16, max_poles) / nv);
+            } else {
+                nv = std::max(4, std::max(16, max_poles) / nu);
+            }
+        }
         if (nu * nv > std::max(16, max_poles) || (nu == last_nu && nv == last_nv) ||
             (in.max_net_poles > 0 && nu * nv > in.max_net_poles))
             break;
