@@ -316,5 +316,53 @@ TEST(SurfaceBrep, CornersJustPastACurvesEndTrimItAtTheEnd) {
     EXPECT_EQ(profile_edges(p), 2);
 }
 
+// A fallback region whose face bounded by its mesh edges fails on its own surface comes back as
+// one face on a B-spline fitted to it, not as its facets. FTC 07's five were corner caps fitted
+// with a torus whose tube circle is nearly on its axis, the cap over the torus's tip, where no
+// face on the torus closes (NotClosed): 123 facet faces. Here the spherical pocket's cap is
+// given such a torus (tube circle 0.1 tolerance from the axis through the cap, within the
+// tolerance of the sphere): its exact face and its mesh-edge face fail the same way.
+TEST(SurfaceBrep, AFallbackFaceThatFailsOnItsSurfaceGoesOnABSpline) {
+    const SamplePart part = test::sample_case("spherical_pocket", test::kFine);
+    const Mesh mesh = build_mesh(part.mesh).value().mesh;
+    const SegmentResult sr = segment(mesh).value();
+    std::vector<RegionSurface> surfaces = region_surfaces(sr);
+    std::size_t cap = sr.regions.size();
+    for (std::size_t r = 0; r < sr.regions.size(); ++r) {
+        if (sr.regions[r].fit.surface.kind == FitKind::kSphere &&
+            (cap == sr.regions.size() || sr.regions[r].facets > sr.regions[cap].facets))
+            cap = r;
+    }
+    ASSERT_LT(cap, sr.regions.size());
+    SurfaceBrepOptions o;
+    o.tolerance = sr.tolerance;
+    o.chordal_deflection = std::max(sr.chordal_deflection, sr.tolerance);
+    const SurfaceBrep exact = brep_detail::build_surface_brep(mesh, sr.region, surfaces, o);
+    ASSERT_TRUE(exact.valid && exact.solid) << exact.problem;
+
+    Vec3 centroid{};
+    double area = 0;
+    for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
+        if (sr.region[FaceId(f)] != static_cast<std::int32_t>(cap)) continue;
+        const double a = mesh.face_area(FaceId(f));
+        for (int i = 0; i < 3; ++i) centroid += (a / 3) * mesh.position(mesh.vertex(FaceId(f), i));
+        area += a;
+    }
+    const Surface sphere = sr.regions[cap].fit.surface;
+    Surface& torus = surfaces[cap].surface;
+    torus.kind = FitKind::kTorus;
+    torus.axis = normalized(centroid / area - sphere.point);
+    torus.radius = 0.1 * sr.tolerance;
+    torus.minor_radius = sphere.radius;
+    const SurfaceBrep b = brep_detail::build_surface_brep(mesh, sr.region, surfaces, o);
+    EXPECT_TRUE(b.valid && b.solid) << b.problem;
+    const auto& g = b.regions[cap];
+    EXPECT_TRUE(g.fallback);
+    EXPECT_TRUE(g.mesh_edges) << g.reason;
+    EXPECT_TRUE(g.spline);
+    EXPECT_EQ(g.faces.size(), 1u);  // not its 1200 facets
+    EXPECT_NEAR(volume(b), volume(exact), 1e-4 * volume(exact));
+}
+
 }  // namespace
 }  // namespace ncrev

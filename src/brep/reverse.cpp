@@ -406,7 +406,10 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                 fb.reason = b.reason;
                 fb.mesh_edges = b.mesh_edges;
                 rep.fallback_faces += b.faces.size();
-                rep.faces_by_kind[b.mesh_edges ? fb.kind : "facet"] += b.faces.size();
+                if (b.spline) fb.reason += "; its face is on a B-spline fitted to its facets";
+                rep.faces_by_kind[!b.mesh_edges ? "facet"
+                                  : b.spline    ? "bspline"
+                                                : fb.kind] += b.faces.size();
                 rep.fallbacks.push_back(std::move(fb));
             } else if (!b.faces.empty()) {
                 rep.faces_by_kind[to_string(g.fit.surface.kind)] += b.faces.size();

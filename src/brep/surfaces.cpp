@@ -103,6 +103,9 @@ constexpr std::size_t kApproximateFrom = 8;
 // Build rounds: each round turns (the smallest of) the regions whose faces failed into facets;
 // a failure spreads at most to neighbours, so a few rounds settle.
 constexpr int kMaxRounds = 12;
+/// A fallback region's B-spline (spline_fallback) is fitted to this many points per facet
+/// edge (and the triangle grid they span): 15 a facet, enough for the smallest cubic net.
+constexpr int kSplineSamples = 4;
 // Why a face BRepMesh leaves without triangles fails (its boundary crosses itself at the
 // mesher's resolution: like a self-intersecting wire, it first gets piecewise-linear edges
 // along its tangent junctions).
@@ -1163,6 +1166,65 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         }
         return !geom[r].IsNull();
     };
+    // A fallback region whose face bounded by its mesh edges fails on its own surface (a cap
+    // over a torus's tip, which no face on the torus can hold; a ring whose polyline wires
+    // take no seam) gets one more try on a B-spline fitted to its vertices: a height field
+    // over its mean plane, which needs no seam, within the segmentation's tolerance. Only then
+    // does it come back as its facets (FTC 07's five were 123 facet faces).
+    std::vector<std::uint8_t> spline(nr, 0);
+    const auto spline_fallback = [&](std::size_t r) -> bool {
+        if (spline[r] || !fallback[r] || as_facets[r]) return false;
+        spline[r] = 1;
+        // Points of its facets (kSplineSamples per edge and across), on its own surface where
+        // it has one: a small region's vertices are fewer than the smallest net's poles.
+        std::vector<Vec3> points, normals;
+        const bool on_surface = regions[r].has_surface;
+        for (std::uint32_t f = 0; f < m.num_faces(); ++f) {
+            const FaceId id(f);
+            if (labels[id] != static_cast<std::int32_t>(r)) continue;
+            const Vec3 a = m.position(m.vertex(id, 0)), b = m.position(m.vertex(id, 1)),
+                       c = m.position(m.vertex(id, 2));
+            const Vec3 n = m.face_normal(id);
+            for (int i = 0; i <= kSplineSamples; ++i) {
+                for (int j = 0; i + j <= kSplineSamples; ++j) {
+                    const double u = double(i) / kSplineSamples, v = double(j) / kSplineSamples;
+                    Vec3 p = a + u * (b - a) + v * (c - a);
+                    Vec3 q = n;
+                    if (on_surface) {
+                        p = closest_point(regions[r].surface, p);
+                        q = normal_at(regions[r].surface, p);
+                        if (dot(q, n) < 0) q = -q;
+                    }
+                    points.push_back(p);
+                    normals.push_back(q);
+                }
+            }
+        }
+        const FitResult fit = fit_bspline(FitInput{points, normals, {}}, opt.tolerance);
+        if (!fit.ok || !(fit.max <= opt.tolerance)) return false;
+        // Within twice the tolerance of the region's own vertices (its surface's points were
+        // fitted; those are within the tolerance of them).
+        for (std::uint32_t f = 0; f < m.num_faces(); ++f) {
+            const FaceId id(f);
+            if (labels[id] != static_cast<std::int32_t>(r)) continue;
+            for (int i = 0; i < 3; ++i) {
+                if (!(distance(fit.surface, m.position(m.vertex(id, i))) <= 2 * opt.tolerance))
+                    return false;
+            }
+        }
+        std::string why;
+        Handle(Geom_Surface) g;
+        try {
+            g = geom_surface(fit.surface, bd.shapes[r], why);
+        } catch (const Standard_Failure&) {
+            return false;
+        }
+        if (g.IsNull()) return false;
+        geom[r] = g;
+        sense[r] = natural_sense(g, m, bd.shapes[r]);
+        out.regions[r].spline = true;
+        return true;
+    };
     GeometryCache cache;
     // After absorbing: borders and loops again, and the geometry of the regions whose facets
     // changed (a surface's seam is put away from its region's centroid). The cache keeps the
@@ -1641,9 +1703,15 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         std::vector<FaceCheck> to_check;
         // A surface face that fails is retried or falls back (below); a fallback region's face
         // bounded by its mesh edges that fails leaves the region as its facets.
+        bool spline_retry = false;
         const auto face_failed = [&](std::size_t r, std::string why) {
             if (fallback[r]) {
-                as_facets[r] = 1;
+                // Mesh-edge faces are made up to round kMaxRounds - 2.
+                if (round + 2 < kMaxRounds && spline_fallback(r)) {
+                    spline_retry = true;
+                } else {
+                    as_facets[r] = 1;
+                }
             } else {
                 failed_region.emplace_back(r, std::move(why));
             }
@@ -1822,6 +1890,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             B.Add(F, W);
             faces[r].push_back(F);
         }
+        if (spline_retry && failed_region.empty()) continue;
         if (!failed_region.empty()) {
             if (!opt.allow_fallback) {
                 out.problem = "region " + std::to_string(failed_region.front().first) + ": " +
@@ -1953,7 +2022,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 if (bad_faces.Contains(f) || bad_faces.Contains(f.Reversed())) {
                     // A fallback's face bounded by mesh edges: its facets next round.
                     if (fallback[r]) {
-                        as_facets[r] = 1;
+                        if (!(round + 2 < kMaxRounds && spline_fallback(r))) as_facets[r] = 1;
                         to_facets = true;
                     } else {
                         bad_regions.push_back(r);

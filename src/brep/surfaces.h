@@ -55,6 +55,9 @@ struct RegionBuild {
     /// the mesh edges of its border (`mesh_edges`), or its facets.
     bool fallback = false;
     bool mesh_edges = false;
+    /// That face is on a B-spline fitted to the region's vertices: on its own surface it
+    /// failed (a torus cap over the tip, a ring whose polyline wires take no seam).
+    bool spline = false;
     std::string reason;              ///< why, when `fallback`
     std::vector<TopoDS_Face> faces;  ///< the faces it became (one, or its facets)
     std::size_t facets = 0;          ///< mesh facets in the region
