@@ -882,6 +882,19 @@ TEST(Fit, ATurnedDomeIsTheInnerPartOfASpindleTorus) {
         EXPECT_LE(norm(closest_point(f.surface, off) - p.points[i]), 1e-6);
         EXPECT_GT(std::fabs(dot(normal_at(f.surface, p.points[i]), p.normals[i])), 1 - 1e-9);
     }
+    // A needle (|R| = 0.9 r: 2 wide, 8.7 long) is no turned dome: refused.
+    Surface needle = local;
+    needle.radius = -9;
+    needle.minor_radius = 10;
+    const double n0 = std::acos((-0.1 - 9) / 10.0), n1 = std::acos((-0.9 - 9) / 10.0);
+    const Patch q =
+        make_patch("needle", needle, 2000, rng, [=](double u, double v, Vec3& pt, Vec3& nq) {
+            const double a = kPi * u, b = n1 + (n0 - n1) * v;
+            nq = {std::cos(b) * std::cos(a), std::cos(b) * std::sin(a), std::sin(b)};
+            pt = Vec3{9 * std::cos(a), 9 * std::sin(a), 0} + 10 * nq;
+        });
+    const FitResult g = fit_patch(q);
+    EXPECT_FALSE(g.ok) << "R " << g.surface.radius << " r " << g.surface.minor_radius;
 }
 
 }  // namespace

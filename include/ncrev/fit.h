@@ -41,9 +41,9 @@ const char* to_string(FitKind kind);
 /// - cone: `point` on the axis, `axis` the unit direction in which the radius grows, `radius`
 ///   of the section through `point` (>= 0), `angle` the half-angle in (0, pi/2);
 /// - torus: `point` its center, `axis` its unit axis, `radius` the major radius R (center to
-///   tube center), `minor_radius` r. R < 0 (with r > |R|) is the inner, lemon-shaped part of
-///   the spindle torus (|R|, r): in each half-plane through the axis the tube circle's center
-///   lies across the axis, at distance |R| (a domed screw head).
+///   tube center), `minor_radius` r. R < 0 is the inner, lemon-shaped part of the spindle
+///   torus (|R|, r): in each half-plane through the axis the tube circle's center lies across
+///   the axis, at distance |R| (a domed screw head); fit() gives it for |R| < r / 2.
 /// - shear_cylinder: the circle of center `point`, `radius`, in the plane normal to `axis`,
 ///   swept along the unit `sweep` (not in that plane): an elliptic cylinder along `sweep`;
 /// - swept_torus: the torus (`point`, `axis`, `radius` R, `minor_radius` r) swept along

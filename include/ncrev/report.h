@@ -68,7 +68,8 @@ std::string to_text(const CurvatureResult& curvature, Unit unit);
 /// "within_tolerance", "surface_index"}; params by kind: plane point, normal; cylinder
 /// axis_point, axis_dir, radius; cone apex, axis_dir (the radius grows along it), half_angle
 /// (rad), radius and axis_point (a section); sphere center, radius; torus center, axis_dir,
-/// major_radius, minor_radius; shear_cylinder center, axis_dir, radius, sweep_dir;
+/// major_radius (negative for the inner, lemon part of a spindle torus: ncrev/fit.h),
+/// minor_radius; shear_cylinder center, axis_dir, radius, sweep_dir;
 /// swept_torus center, axis_dir, major_radius, minor_radius, sweep_dir; bspline degree,
 /// num_u, num_v, poles (num_u x num_v points, u fastest).
 std::string to_json(const InfoReport& info, const SegmentResult& segment, int indent = 2);

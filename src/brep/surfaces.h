@@ -55,8 +55,8 @@ struct RegionBuild {
     /// the mesh edges of its border (`mesh_edges`), or its facets.
     bool fallback = false;
     bool mesh_edges = false;
-    /// That face is on a B-spline fitted to the region's vertices: on its own surface it
-    /// failed (a torus cap over the tip, a ring whose polyline wires take no seam).
+    /// That face is on a B-spline fitted to points of the region's facets: on its own surface
+    /// it failed (a torus cap over the tip, a strip whose polyline wires take no seam).
     bool spline = false;
     std::string reason;              ///< why, when `fallback`
     std::vector<TopoDS_Face> faces;  ///< the faces it became (one, or its facets)
