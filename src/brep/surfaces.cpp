@@ -1174,15 +1174,17 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     // 123 facet faces).
     std::vector<std::uint8_t> spline(nr, 0);
     const auto spline_fallback = [&](std::size_t r) -> bool {
-        if (spline[r] || !fallback[r] || as_facets[r]) return false;
+        if (spline[r]) return false;
         spline[r] = 1;
+        std::vector<FaceId> own;
+        for (std::uint32_t f = 0; f < m.num_faces(); ++f) {
+            if (labels[FaceId(f)] == static_cast<std::int32_t>(r)) own.push_back(FaceId(f));
+        }
         // Points of its facets (kSplineSamples per edge and across), on its own surface where
         // it has one: a small region's vertices are fewer than the smallest net's poles.
         std::vector<Vec3> points, normals;
         const bool on_surface = regions[r].has_surface;
-        for (std::uint32_t f = 0; f < m.num_faces(); ++f) {
-            const FaceId id(f);
-            if (labels[id] != static_cast<std::int32_t>(r)) continue;
+        for (const FaceId id : own) {
             const Vec3 a = m.position(m.vertex(id, 0)), b = m.position(m.vertex(id, 1)),
                        c = m.position(m.vertex(id, 2));
             const Vec3 n = m.face_normal(id);
@@ -1205,9 +1207,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         if (!fit.ok || !(fit.max <= opt.tolerance)) return false;
         // Within twice the tolerance of the region's own vertices (its surface's points were
         // fitted; those are within the tolerance of them).
-        for (std::uint32_t f = 0; f < m.num_faces(); ++f) {
-            const FaceId id(f);
-            if (labels[id] != static_cast<std::int32_t>(r)) continue;
+        for (const FaceId id : own) {
             for (int i = 0; i < 3; ++i) {
                 if (!(distance(fit.surface, m.position(m.vertex(id, i))) <= 2 * opt.tolerance))
                     return false;
@@ -1704,11 +1704,21 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         std::vector<FaceCheck> to_check;
         // A surface face that fails is retried or falls back (below); a fallback region's face
         // bounded by its mesh edges that fails leaves the region as its facets.
+        // The fallback regions' faces bounded by mesh edges, but not in the last two rounds:
+        // facets always close the shell, so the last round cannot fail on such a face.
+        const auto makes_mesh_edge_faces = [&](int k) {
+            return opt.allow_fallback && k < kMaxRounds - 1;
+        };
+        const bool mesh_edge_faces = makes_mesh_edge_faces(round);
+        // A fallback region whose mesh-edge face failed: on a B-spline next round, if that
+        // round still makes such faces and the fit succeeds.
+        const auto on_spline_next = [&](std::size_t r) {
+            return makes_mesh_edge_faces(round + 1) && spline_fallback(r);
+        };
         bool spline_retry = false;
         const auto face_failed = [&](std::size_t r, std::string why) {
             if (fallback[r]) {
-                // Mesh-edge faces are made up to round kMaxRounds - 2.
-                if (round + 2 < kMaxRounds && spline_fallback(r)) {
+                if (on_spline_next(r)) {
                     spline_retry = true;
                 } else {
                     as_facets[r] = 1;
@@ -1717,9 +1727,6 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 failed_region.emplace_back(r, std::move(why));
             }
         };
-        // The fallback regions' faces bounded by mesh edges, but not in the last two rounds:
-        // facets always close the shell, so the last round cannot fail on such a face.
-        const bool mesh_edge_faces = opt.allow_fallback && round < kMaxRounds - 1;
         for (std::size_t r = 0; r < nr; ++r) {
             if (bd.facets[r] == 0) continue;
             if (fallback[r] && (!mesh_edge_faces || as_facets[r] || !fallback_surface(r))) {
@@ -2023,7 +2030,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 if (bad_faces.Contains(f) || bad_faces.Contains(f.Reversed())) {
                     // A fallback's face bounded by mesh edges: its facets next round.
                     if (fallback[r]) {
-                        if (!(round + 2 < kMaxRounds && spline_fallback(r))) as_facets[r] = 1;
+                        if (!on_spline_next(r)) as_facets[r] = 1;
                         to_facets = true;
                     } else {
                         bad_regions.push_back(r);

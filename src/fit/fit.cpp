@@ -1154,6 +1154,7 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
     double base = kBSplineStartPoles;
     const auto max_poles =
         static_cast<int>(std::min<std::size_t>(n / 2, kBSplineMaxPoles * kBSplineMaxPoles));
+    const int pole_limit = std::max(16, max_poles);  // the smallest net is always tried
     FitResult best = fail;
     int last_nu = 0, last_nv = 0;  // the net stops growing at kBSplineMaxPoles
     for (;;) {
@@ -1164,14 +1165,14 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
             std::max(4, static_cast<int>(std::lround(base * std::max(1.0, 1.0 / aspect)))));
         // A long strip's first net: as many poles along it as the points allow (its 4 x 24
         // proportional net would have more poles than half its points and no net be tried).
-        if (last_nu == 0 && nu * nv > std::max(16, max_poles)) {
+        if (last_nu == 0 && nu * nv > pole_limit) {
             if (nu > nv) {
-                nu = std::max(4, std::max(16, max_poles) / nv);
+                nu = std::max(4, pole_limit / nv);
             } else {
-                nv = std::max(4, std::max(16, max_poles) / nu);
+                nv = std::max(4, pole_limit / nu);
             }
         }
-        if (nu * nv > std::max(16, max_poles) || (nu == last_nu && nv == last_nv) ||
+        if (nu * nv > pole_limit || (nu == last_nu && nv == last_nv) ||
             (in.max_net_poles > 0 && nu * nv > in.max_net_poles))
             break;
         last_nu = nu, last_nv = nv;
