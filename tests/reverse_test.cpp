@@ -484,7 +484,7 @@ struct FaceMatch {
     std::size_t matched = 0, split = 0, joined = 0;  ///< true faces; regions over several
 };
 constexpr double kMatchShare = 0.9;
-FaceMatch match_faces(const SamplePart& part) {
+FaceMatch match_faces(const SamplePart& part, bool list = false) {
     FaceMatch fm;
     const Result<BuildResult> built = build_mesh(part.mesh);
     if (!built.ok()) return fm;
@@ -511,6 +511,63 @@ FaceMatch match_faces(const SamplePart& part) {
     }
     for (const auto& [t, n] : pieces) fm.split += n > 1;
     for (const auto& [g, n] : faces) fm.joined += n > 1;
+    if (list) {  // each split true face: its kind and area, and its regions' shares
+        const std::vector<Region>& regions = seg.value().regions;
+        for (const auto& [t, n] : pieces) {
+            if (n < 2 || t < 0 || static_cast<std::size_t>(t) >= part.faces.size()) continue;
+            const SampleFace& sf = part.faces[static_cast<std::size_t>(t)];
+            std::printf(
+                "|   split: true face %lld (%s, %.1f mm2, %llu facets):", static_cast<long long>(t),
+                sf.kind.c_str(), sf.area, static_cast<unsigned long long>(sf.num_facets));
+            for (const auto& [key, a] : both) {
+                if (key.first != t || a < (1 - kMatchShare) * face_area[t]) continue;
+                const Region& r = regions[static_cast<std::size_t>(key.second)];
+                std::printf(" region %d %s %.0f%% (%llu facets, its %.0f%%)", key.second,
+                            to_string(r.fit.surface.kind), 100 * a / face_area[t],
+                            static_cast<unsigned long long>(r.facets),
+                            100 * a / region_area[key.second]);
+            }
+            std::printf(" |\n");
+        }
+        // Regions holding under a tenth of every true face they touch: invisible above.
+        std::map<std::int32_t, std::pair<double, std::int64_t>> main_face;  // share, face
+        for (const auto& [key, a] : both) {
+            auto& m = main_face[key.second];
+            if (a > m.first) m = {a, key.first};
+        }
+        std::size_t slivers = 0;
+        for (const auto& [g, m] : main_face) {
+            const double share = m.first / face_area[m.second];
+            if (share >= 1 - kMatchShare) continue;
+            ++slivers;
+            const Region& r = regions[static_cast<std::size_t>(g)];
+            const SampleFace* sf =
+                m.second >= 0 && static_cast<std::size_t>(m.second) < part.faces.size()
+                    ? &part.faces[static_cast<std::size_t>(m.second)]
+                    : nullptr;
+            std::printf(
+                "|   sliver: region %d %s (%llu facets) mostly on true face %lld %s, %.1f%% of it "
+                "|\n",
+                g, to_string(r.fit.surface.kind), static_cast<unsigned long long>(r.facets),
+                static_cast<long long>(m.second), sf ? sf->kind.c_str() : "?", 100 * share);
+        }
+        std::printf("|   %zu regions, %zu slivers |\n", regions.size(), slivers);
+        if (const char* fe = std::getenv("FACE")) {  // FACE=n: that true face's facets
+            const std::int64_t want = std::atoll(fe);
+            for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+                if (mesh.cuts()[f] != want) continue;
+                const FaceId ff(static_cast<std::uint32_t>(f));
+                const Vec3 n = mesh.face_normal(ff);
+                std::printf("|   facet %zu region %d n (%.3f %.3f %.3f):", f,
+                            seg.value().region[ff], n.x, n.y, n.z);
+                for (int i = 0; i < 3; ++i) {
+                    const Vec3 p = mesh.position(mesh.vertex(ff, i));
+                    std::printf(" (%.3f %.3f %.3f)", p.x, p.y, p.z);
+                }
+                std::printf("\n");
+            }
+        }
+    }
     return fm;
 }
 
@@ -539,7 +596,7 @@ TEST(ReverseStudy, DISABLED_Corpus) {
         }
         const Outcome o = reverse_part(made.value(), false, ReverseMethod::kAuto, "study");
         print_row(path.filename().string(), "STL", o);
-        const FaceMatch fm = match_faces(made.value());
+        const FaceMatch fm = match_faces(made.value(), only != nullptr);
         std::printf(
             "|   face for face: %zu of %zu true faces one region each; %zu true faces in "
             "several regions, %zu regions over several true faces |\n",
