@@ -11,6 +11,7 @@
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepCheck_Analyzer.hxx>
+#include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepGProp.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
@@ -36,8 +37,8 @@ namespace ncrev {
 namespace {
 
 /// The shape's BRepMesh triangulation as a facet bucket, facets outward.
-TriangleSoup tessellate(const TopoDS_Shape& shape, double deflection) {
-    BRepMesh_IncrementalMesh mesher(shape, deflection, false, 0.5, false);
+TriangleSoup tessellate(const TopoDS_Shape& shape, double deflection, double angular = 0.5) {
+    BRepMesh_IncrementalMesh mesher(shape, deflection, false, angular, false);
     TriangleSoup soup;
     for (TopExp_Explorer ex(shape, TopAbs_FACE); ex.More(); ex.Next()) {
         const TopoDS_Face face = TopoDS::Face(ex.Current());
@@ -297,6 +298,68 @@ TEST(Reverse, ADomedHeadIsTheInnerPartOfASpindleTorus) {
     // range began between knots, and OpenCASCADE's volume lost 4.3 mm3 (0.6 %) of the solid.
     EXPECT_NEAR(rev->solid_volume, props.Mass(), 1e-4 * props.Mass());
     EXPECT_NEAR(back.volume, props.Mass(), 1e-4 * props.Mass());
+}
+
+/// A 60 x 40 x 25 block with every edge filleted at 1 (after its four vertical edges are
+/// rounded at `corner`, when positive), tessellated as the corpus study does it with BRepMesh
+/// at the given chordal and angular deflections.
+struct FilletedBlock {
+    TopoDS_Shape shape;
+    Mesh mesh;
+};
+FilletedBlock filleted_block(double corner, double deflection, double angular) {
+    const TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 60, 40, 25).Shape();
+    TopoDS_Shape rounded = box;
+    if (corner > 0) {
+        BRepFilletAPI_MakeFillet round(box);
+        for (TopExp_Explorer x(box, TopAbs_EDGE); x.More(); x.Next()) {
+            const TopoDS_Edge& e = TopoDS::Edge(x.Current());
+            TopoDS_Vertex v1, v2;
+            TopExp::Vertices(e, v1, v2);
+            const gp_Pnt a = BRep_Tool::Pnt(v1), b = BRep_Tool::Pnt(v2);
+            if (std::abs(a.X() - b.X()) < 1e-9 && std::abs(a.Y() - b.Y()) < 1e-9)
+                round.Add(corner, e);
+        }
+        rounded = round.Shape();
+    }
+    BRepFilletAPI_MakeFillet fillet(rounded);
+    for (TopExp_Explorer x(rounded, TopAbs_EDGE); x.More(); x.Next())
+        fillet.Add(1, TopoDS::Edge(x.Current()));
+    FilletedBlock b{fillet.Shape(), {}};
+    b.mesh = heal(tessellate(b.shape, deflection, angular));
+    return b;
+}
+
+std::map<std::string, int> region_kinds(const SegmentResult& s) {
+    std::map<std::string, int> kinds;
+    for (const Region& g : s.regions) ++kinds[to_string(g.fit.surface.kind)];
+    return kinds;
+}
+
+// A fillet of radius 1 in 10-degree strips (each two long facets) ends at ball corners. The
+// growing took a facet of a ball into a strip's plane (within the tolerance of the plane, not
+// of the fillet's cylinder), and no cylinder then took two neighbouring strips: 31 regions
+// for 26 faces, fillets in planes. Merging leaves such a stray to the ball that fits it.
+TEST(Reverse, ACoarseFilletIsOneCylinderBesideItsCornerBalls) {
+    const FilletedBlock b = filleted_block(0, 0.05, 0.17);
+    ASSERT_TRUE(compute_stats(b.mesh).closed);
+    ASSERT_EQ(count_faces(b.shape), 26u);
+    const Result<SegmentResult> seg = segment(b.mesh);
+    ASSERT_TRUE(seg.ok());
+    EXPECT_EQ(seg->regions.size(), 26u);
+    const auto kinds = region_kinds(seg.value());
+    EXPECT_EQ(kinds.count("cylinder") ? kinds.at("cylinder") : 0, 12);
+    EXPECT_EQ(kinds.count("sphere") ? kinds.at("sphere") : 0, 8);
+    for (const Region& g : seg->regions) {
+        if (g.fit.surface.kind == FitKind::kPlane) continue;
+        EXPECT_NEAR(g.fit.surface.radius, 1.0, 1e-3);
+    }
+    const auto path = out_dir() / "filleted_block.step";
+    auto rev = reverse_to_step(b.mesh, path, {});
+    ASSERT_TRUE(rev.ok()) << rev.error().describe();
+    EXPECT_TRUE(rev->valid && rev->solid);
+    EXPECT_TRUE(rev->fallbacks.empty());
+    EXPECT_EQ(rev->faces, 26u);
 }
 
 }  // namespace

@@ -96,6 +96,9 @@ constexpr int kNoisePasses = 3;
 constexpr std::size_t kLikenessSamples = 1024;
 /// The merge queue's lower bounds take every kLikenessBoundThin-th of those (merge_regions()).
 constexpr std::size_t kLikenessBoundThin = 32;
+/// A merge may leave out this share of its facets (at least one) as strays for its neighbours
+/// (see fit_without_strays()): a few facets of a corner, never a face's row.
+constexpr double kStrayShare = 0.1;
 /// Regions of at most this many facets are dissolved into their neighbours when these fit them.
 constexpr std::size_t kSmallRegion = 8;
 /// Rounds of border refinement (each moves facets one row at most).
@@ -289,9 +292,12 @@ bool chords_agree(const Context& c, const Surface& s, std::span<const std::uint3
 
 /// The first kind in kKindOrder (of `kinds`) whose fit keeps every vertex of `faces` within
 /// the tolerance and whose chords the facets are (chords_agree()).
+/// `misses`, when given, receives the surfaces that were fitted but refused (a vertex beyond the
+/// tolerance, or facets that are not their chords), in the order tried.
 std::optional<FitResult> fit_faces(Context& c, std::span<const std::uint32_t> faces,
                                    FitKindSet kinds = kRevolutionFitKinds,
-                                   std::optional<FitKind> first = std::nullopt) {
+                                   std::optional<FitKind> first = std::nullopt,
+                                   std::vector<Surface>* misses = nullptr) {
     PointSet ps;
     c.gatherers.local().gather(c.m, c.fd, faces, ps);
     // `first` (the kind a growing region has) is tried before the others: refitting a torus of
@@ -308,8 +314,9 @@ std::optional<FitResult> fit_faces(Context& c, std::span<const std::uint32_t> fa
         if ((kinds & fit_kind_bit(kind)) == 0) continue;
         if (ps.points.size() < kMinVertices[static_cast<int>(kind)]) continue;
         FitResult r = fit(kind, in);
-        if (!r.ok || r.max > c.tol) continue;
-        if (chords_agree(c, r.surface, faces)) return r;
+        if (!r.ok) continue;
+        if (r.max <= c.tol && chords_agree(c, r.surface, faces)) return r;
+        if (misses) misses->push_back(r.surface);
     }
     return std::nullopt;
 }
@@ -560,8 +567,38 @@ double unlikeness(const Context& c, const Draft& a, const Draft& b, std::size_t 
     return std::min(worst(a, b.surface), worst(b, a.surface));
 }
 
+/// The surface that fits `faces` but for a few strays, tried on each of `misses` (surfaces
+/// the whole refused) in turn: the facets that do not fit one (facet_fits()) left out while they
+/// are at most kStrayShare of them, and its kind refitted to the rest. `strays` receives the
+/// facets the refitted surface does not take back either.
+std::optional<FitResult> fit_without_strays(Context& c, std::span<const std::uint32_t> faces,
+                                            const std::vector<Surface>& misses,
+                                            std::vector<std::uint32_t>& strays) {
+    const auto limit =
+        std::max<std::size_t>(1, static_cast<std::size_t>(kStrayShare * faces.size()));
+    std::vector<std::uint32_t> rest;
+    for (const Surface& s : misses) {
+        rest.clear();
+        strays.clear();
+        for (const std::uint32_t f : faces) (facet_fits(c, s, f) ? rest : strays).push_back(f);
+        if (strays.empty() || strays.size() > limit) continue;
+        auto r = fit_faces(c, rest, fit_kind_bit(s.kind));
+        if (!r) continue;
+        std::erase_if(strays, [&](std::uint32_t f) { return facet_fits(c, r->surface, f); });
+        return r;
+    }
+    strays.clear();
+    return std::nullopt;
+}
+
 /// Merges adjacent regions that one analytic surface fits, most alike pair first (method.md
 /// 3.6); the merged region keeps the larger one's index. Returns the number of merges.
+///
+/// A union that one surface fits but for a few facets on its border (fit_without_strays())
+/// merges too, those facets going to the neighbouring region that fits them best: a facet of
+/// a corner patch that the growing took into a strip of a coarse fillet (it lies within the
+/// tolerance of the strip's plane, not of the fillet's cylinder) would otherwise keep the
+/// fillet in one plane per strip.
 std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
     std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
     // Across sharp edges too (a coarse fillet's facets meet at more than the sharp angle): a
@@ -592,6 +629,9 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
     };
     for (const auto& [a, b] : pairs) push(a, b);
     std::uint64_t merges = 0;
+    std::vector<Surface> misses;
+    std::vector<std::uint32_t> strays;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> homes;  // (stray facet, its region)
     while (!pq.empty()) {
         const auto [cost, a, b, va, vb, exact] = pq.top();
         pq.pop();
@@ -616,10 +656,51 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
             if (firm_plane(c, drafts[a])) kinds = fit_kind_bit(drafts[a].surface.kind);
             if (firm_plane(c, drafts[b])) kinds &= fit_kind_bit(drafts[b].surface.kind);
         }
-        auto r = fit_faces(c, faces, kinds);
+        misses.clear();
+        auto r = fit_faces(c, faces, kinds, std::nullopt, &misses);
+        homes.clear();
+        if (!r && !misses.empty()) {
+            r = fit_without_strays(c, faces, misses, strays);
+            // Strays are a few facets of one of the two, never the better part of either
+            // (a region whose every facet fits elsewhere is not merged by leaving it out).
+            std::size_t from_a = 0;
+            for (const std::uint32_t f : strays) from_a += region[f] == a;
+            if (!strays.empty() && (2 * from_a >= drafts[a].faces.size() ||
+                                    2 * (strays.size() - from_a) >= drafts[b].faces.size())) {
+                r.reset();
+            }
+            // Each stray goes to the neighbouring region (other than these two) that fits it
+            // best; with none, no merge.
+            for (const std::uint32_t f : strays) {
+                std::uint32_t best = kNone;
+                double best_cost = kInf;
+                for (const std::uint32_t g : c.fd.adj[f]) {
+                    const std::uint32_t x = g == kNone ? kNone : region[g];
+                    if (x == kNone || x == a || x == b || !mergeable(x)) continue;
+                    const double fc = facet_cost(c, drafts[x].surface, f);
+                    if (fc > c.tol) continue;
+                    if (best == kNone || fc < best_cost || (fc == best_cost && x < best)) {
+                        best = x;
+                        best_cost = fc;
+                    }
+                }
+                if (best == kNone) {
+                    r.reset();
+                    break;
+                }
+                homes.emplace_back(f, best);
+            }
+        }
         if (!r) continue;
         const bool keep_a = drafts[a].faces.size() >= drafts[b].faces.size();
         const std::uint32_t keep = keep_a ? a : b, gone = keep_a ? b : a;
+        for (const std::uint32_t f : faces) region[f] = keep;
+        for (const auto& [f, x] : homes) {
+            std::erase(faces, f);
+            region[f] = x;
+            drafts[x].faces.push_back(f);
+            ++version[x];
+        }
         std::sort(faces.begin(), faces.end());
         drafts[keep].faces = std::move(faces);
         drafts[keep].surface = r->surface;
@@ -634,11 +715,21 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
         std::erase_if(n,
                       [&](std::uint32_t x) { return x == keep || x == gone || !drafts[x].alive; });
         nbrs[keep] = n;
+        // (A stray's new region bordered one of the two through it: it is among these.)
         for (const std::uint32_t x : n) {
             std::replace(nbrs[x].begin(), nbrs[x].end(), gone, keep);
             std::sort(nbrs[x].begin(), nbrs[x].end());
             nbrs[x].erase(std::unique(nbrs[x].begin(), nbrs[x].end()), nbrs[x].end());
             push(keep, x);
+        }
+        // A region that took a stray has a new version: its other pairs again.
+        std::vector<std::uint32_t> took;
+        for (const auto& [f, x] : homes) took.push_back(x);
+        std::sort(took.begin(), took.end());
+        took.erase(std::unique(took.begin(), took.end()), took.end());
+        for (const std::uint32_t x : took) {
+            for (const std::uint32_t y : nbrs[x])
+                if (y != keep) push(x, y);
         }
     }
     return merges;
