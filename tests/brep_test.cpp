@@ -362,5 +362,30 @@ TEST(Reverse, ACoarseFilletIsOneCylinderBesideItsCornerBalls) {
     EXPECT_EQ(rev->faces, 26u);
 }
 
+// The same block with its vertical edges rounded at 10 first: the fillets run round the
+// corners as tori (R 9, r 1). A few rows of such a ring are nearly a piece of a straight tube,
+// whose normals nearly all meet the tube's center line: the line that meets them all (the
+// torus's axis) went to the mesh normals' errors and the pieces stayed apart (27 regions at
+// 10-degree steps, 42 at 29). The spine start (fitting.md) fits them.
+TEST(Reverse, ThinFilletRingsAreTori) {
+    for (const auto& [deflection, angular, regions] :
+         {std::tuple{0.2, 0.17, 26u}, std::tuple{0.02, 0.5, 29u}}) {
+        const FilletedBlock b = filleted_block(10, deflection, angular);
+        ASSERT_TRUE(compute_stats(b.mesh).closed);
+        ASSERT_EQ(count_faces(b.shape), 26u);
+        const Result<SegmentResult> seg = segment(b.mesh);
+        ASSERT_TRUE(seg.ok());
+        EXPECT_LE(seg->regions.size(), regions) << angular;
+        int tori = 0;
+        for (const Region& g : seg->regions) {
+            if (g.fit.surface.kind != FitKind::kTorus) continue;
+            ++tori;
+            EXPECT_NEAR(g.fit.surface.radius, 9.0, 1e-2) << angular;
+            EXPECT_NEAR(g.fit.surface.minor_radius, 1.0, 1e-3) << angular;
+        }
+        EXPECT_GE(tori, 8) << angular;
+    }
+}
+
 }  // namespace
 }  // namespace ncrev

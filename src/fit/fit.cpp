@@ -993,6 +993,161 @@ FitResult fit_cone(const FitInput& in) {
     return better_fit(other, res, in) ? other : res;
 }
 
+/// spine_start() searches with at most this many of the points (evenly strided): it finds a
+/// start, the refinement uses them all.
+constexpr std::size_t kSpineSamples = 512;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+/// The tube radii spine_start() tries: +-4 x the points' reach x 2^(-k/2) for k < kSpineSteps,
+/// down to about 1e-4 of the reach (finer than any tube a tessellation of the part resolves);
+/// then golden-section steps between the best one's neighbours.
+constexpr int kSpineSteps = 28;
+constexpr int kSpineGoldenSteps = 40;
+
+/// A torus from spine_start() stands only where the points run along its tube for at least
+/// this many tube radii (a thin fillet ring, what it is for). Over a shorter run a bent tube
+/// and a straight one (a cylinder) differ by a few hundredths of a millimetre, which a stray
+/// facet or two of a neighbouring face provides: a cylinder band beside a ball end of its
+/// radius fitted tubes bent at 2 to 4 radii.
+constexpr double kSpineMinRun = 3;
+
+/// How far the points run along the spine of m: its radius times the angle about its axis
+/// that they cover (the full circle less the largest gap between them).
+double spine_run(const FitInput& in, const TorusModel& m) {
+    std::vector<double> angle;
+    angle.reserve(in.points.size());
+    for (const Vec3& p : in.points) {
+        const Vec3 q = p - m.a.c;
+        angle.push_back(std::atan2(dot(q, m.a.v), dot(q, m.a.u)));
+    }
+    if (angle.empty()) return 0;
+    std::sort(angle.begin(), angle.end());
+    double gap = angle.front() + 2 * std::numbers::pi - angle.back();
+    for (std::size_t i = 1; i < angle.size(); ++i) gap = std::max(gap, angle[i] - angle[i - 1]);
+    return std::fabs(m.R) * (2 * std::numbers::pi - gap);
+}
+
+/// The circle nearest the points s (weights w): its plane by principal components, the circle in
+/// it by Kasa's fit. Returns the weighted mean squared distance of s from it; infinite when
+/// there is none.
+double circle_through(const std::vector<Vec3>& s, const std::vector<double>& w, Vec3& c, Vec3& d,
+                      double& R) {
+    double tw = 0;
+    Vec3 g{};
+    for (std::size_t i = 0; i < s.size(); ++i) g += w[i] * s[i], tw += w[i];
+    if (!(tw > 0)) return kInf;
+    g = g / tw;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const Vec3 q = s[i] - g;
+        const Eigen::Vector3d e(q.x, q.y, q.z);
+        cov += w[i] * e * e.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+    if (es.info() != Eigen::Success) return kInf;
+    d = normalized(Vec3{es.eigenvectors()(0, 0), es.eigenvectors()(1, 0), es.eigenvectors()(2, 0)});
+    Vec3 u, v;
+    frame(d, u, v);
+    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const Vec3 q = s[i] - g;
+        const double x = dot(q, u), y = dot(q, v);
+        const Eigen::Vector3d row(x, y, 1.0);
+        ata += w[i] * row * row.transpose();
+        atb -= w[i] * (x * x + y * y) * row;
+    }
+    const Eigen::Vector3d k = ata.ldlt().solve(atb);
+    const double cx = -0.5 * k(0), cy = -0.5 * k(1), R2 = cx * cx + cy * cy - k(2);
+    if (!k.allFinite() || !(R2 > 0)) return kInf;
+    R = std::sqrt(R2);
+    c = g + cx * u + cy * v;
+    double sum = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const Vec3 q = s[i] - g;
+        const double h = dot(q, d), x = dot(q, u) - cx, y = dot(q, v) - cy;
+        const double e = std::hypot(x, y) - R;
+        sum += w[i] * (h * h + e * e);
+    }
+    return sum / tw;
+}
+
+/// A second start for a torus, from its spine: the points moved along their normals by the
+/// tube radius lie on one circle (the tube's center line), whose plane's normal is the axis
+/// and whose radius is the major radius. The tube radius (either side: a fillet's tube is
+/// outside the material, a round's inside) is the one that puts them closest to a circle.
+/// Where the first start fails: a patch of a few rows of a thin fillet ring, whose normals
+/// nearly all meet the tube's center line too, leaves the line that meets them all (the axis
+/// of the first start) to the mesh normals' errors.
+bool spine_start(const FitInput& in, TorusModel& m) {
+    const std::size_t n = in.points.size();
+    if (in.normals.size() != n || n < 8) return false;
+    const std::size_t step = std::max<std::size_t>(1, n / kSpineSamples);
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < n; i += step) idx.push_back(i);
+    std::vector<double> w(idx.size());
+    for (std::size_t k = 0; k < idx.size(); ++k) w[k] = weight(in, idx[k]);
+    const Vec3 g = centroid(in);
+    double reach = 0;
+    for (const std::size_t i : idx) reach = std::max(reach, norm(in.points[i] - g));
+    if (!(reach > 0)) return false;
+    std::vector<Vec3> s(idx.size());
+    Vec3 c, d;
+    double R = 0;
+    const auto spread = [&](double rho) {
+        for (std::size_t k = 0; k < idx.size(); ++k)
+            s[k] = in.points[idx[k]] - rho * in.normals[idx[k]];
+        return circle_through(s, w, c, d, R);
+    };
+    // The grid: radii of both signs, largest first; the best and its neighbours bracket it.
+    std::vector<double> grid;
+    for (int k = 0; k < kSpineSteps; ++k) grid.push_back(4 * reach * std::pow(0.5, 0.5 * k));
+    for (int k = kSpineSteps - 1; k >= 0; --k) grid.push_back(-grid[static_cast<std::size_t>(k)]);
+    std::size_t best = 0;
+    double best_spread = kInf;
+    for (std::size_t k = 0; k < grid.size(); ++k) {
+        const double e = spread(grid[k]);
+        if (e < best_spread) best_spread = e, best = k;
+    }
+    if (!std::isfinite(best_spread)) return false;
+    // Between the neighbours (of the same sign: a tube radius does not pass through zero).
+    const std::size_t half = static_cast<std::size_t>(kSpineSteps);
+    const bool first_half = best < half;
+    const std::size_t lo_i = best > (first_half ? 0 : half) ? best - 1 : best;
+    const std::size_t hi_i = best + 1 < (first_half ? half : grid.size()) ? best + 1 : best;
+    double lo = grid[lo_i], hi = grid[hi_i];
+    const double phi = 0.5 * (std::sqrt(5.0) - 1);
+    double x1 = hi - phi * (hi - lo), x2 = lo + phi * (hi - lo);
+    double f1 = spread(x1), f2 = spread(x2);
+    for (int it = 0; it < kSpineGoldenSteps; ++it) {
+        if (f1 < f2) {
+            hi = x2, x2 = x1, f2 = f1;
+            x1 = hi - phi * (hi - lo);
+            f1 = spread(x1);
+        } else {
+            lo = x1, x1 = x2, f1 = f2;
+            x2 = lo + phi * (hi - lo);
+            f2 = spread(x2);
+        }
+    }
+    const double rho = 0.5 * (lo + hi);
+    if (!std::isfinite(spread(rho))) return false;
+    m = TorusModel{Axis::make(c, d), R, std::fabs(rho)};
+    return finite(c) && finite(d) && R > 0 && std::fabs(rho) > 0;
+}
+
+/// The torus refined from m, with its radii checked.
+FitResult refine_torus(TorusModel& m, const FitInput& in) {
+    const int it = refine(m, in);
+    FitResult res = finish(m, it, in);
+    // A negative major radius is the inner part of a spindle torus (r > |R|): the lemon-shaped
+    // dome of a screw head, whose meridian arc is centered across the axis (kLemonMaxAxisOffset).
+    if (res.ok && !(m.r > 0 && (m.R > 0 || (-m.R > 0 && -m.R < kLemonMaxAxisOffset * m.r)))) {
+        res.ok = false;
+        res.failure = "the radii left their range";
+    }
+    return res;
+}
+
 FitResult fit_torus(const FitInput& in) {
     Vec3 c, d;
     if (!axis_from_normals(in, centroid(in), c, d)) {
@@ -1015,15 +1170,14 @@ FitResult fit_torus(const FitInput& in) {
     if (!x.allFinite() || !(r2 > 0))
         return failed(FitKind::kTorus, "no tube circle through the profile");
     TorusModel m{Axis::make(c + h0 * d, d), R, std::sqrt(r2)};
-    const int it = refine(m, in);
-    FitResult res = finish(m, it, in);
-    // A negative major radius is the inner part of a spindle torus (r > |R|): the lemon-shaped
-    // dome of a screw head, whose meridian arc is centered across the axis (kLemonMaxAxisOffset).
-    if (res.ok && !(m.r > 0 && (m.R > 0 || (-m.R > 0 && -m.R < kLemonMaxAxisOffset * m.r)))) {
-        res.ok = false;
-        res.failure = "the radii left their range";
-    }
-    return res;
+    FitResult res = refine_torus(m, in);
+    // A fit within what the caller accepts stands; otherwise also from the spine.
+    if (res.ok && in.accept > 0 && res.max <= in.accept) return res;
+    TorusModel m2{};
+    if (!spine_start(in, m2)) return res;
+    FitResult other = refine_torus(m2, in);
+    if (!other.ok || spine_run(in, m2) < kSpineMinRun * m2.r) return res;
+    return better_fit(other, res, in) ? other : res;
 }
 
 /// Gauss-Newton for the parameters (u, v) of the point of `b` nearest to p, from a start,
