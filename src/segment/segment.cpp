@@ -96,9 +96,14 @@ constexpr int kNoisePasses = 3;
 constexpr std::size_t kLikenessSamples = 1024;
 /// The merge queue's lower bounds take every kLikenessBoundThin-th of those (merge_regions()).
 constexpr std::size_t kLikenessBoundThin = 32;
-/// A merge may leave out this share of its facets (at least one) as strays for its neighbours
-/// (see fit_without_strays()): a few facets of a corner, never a face's row.
+/// A merge may leave out this share of its area as strays for its neighbours (see
+/// fit_without_strays()): a few small facets of a corner, never a face's row.
 constexpr double kStrayShare = 0.1;
+/// Strays that no neighbour takes become regions of their own while each group holds at most
+/// this share of the merge's area: the few small facets of a corner beside a coarse fillet's
+/// long strips (NIST FTC 07: 0.2 %), not the rim rows of two small regions of like facets
+/// (CTC 03's cone and cylinder at 3-4 %, which stay apart).
+constexpr double kOrphanShare = 0.01;
 /// Regions of at most this many facets are dissolved into their neighbours when these fit them.
 constexpr std::size_t kSmallRegion = 8;
 /// Rounds of border refinement (each moves facets one row at most).
@@ -568,20 +573,38 @@ double unlikeness(const Context& c, const Draft& a, const Draft& b, std::size_t 
 }
 
 /// The surface that fits `faces` but for a few strays, tried on each of `misses` (surfaces
-/// the whole refused) in turn: the facets that do not fit one (facet_fits()) left out while they
-/// are at most kStrayShare of them, and its kind refitted to the rest. `strays` receives the
-/// facets the refitted surface does not take back either.
+/// the whole refused) in turn: the facets that do not fit one (facet_cost()) left out, worst
+/// first, while they hold at most kStrayShare of the area, and its kind refitted to the rest.
+/// `strays` receives the facets the refitted surface does not take back either.
 std::optional<FitResult> fit_without_strays(Context& c, std::span<const std::uint32_t> faces,
                                             const std::vector<Surface>& misses,
                                             std::vector<std::uint32_t>& strays) {
-    const auto limit =
-        std::max<std::size_t>(1, static_cast<std::size_t>(kStrayShare * faces.size()));
+    double total = 0;
+    for (const std::uint32_t f : faces) total += c.fd.area[f];
+    std::vector<std::pair<double, std::uint32_t>> cost;  // worst first
     std::vector<std::uint32_t> rest;
     for (const Surface& s : misses) {
-        rest.clear();
+        // The facets that miss the surface, worst first, while their area allows: a few
+        // facets of a neighbour pull the whole fit off, and those of the region beside them
+        // may miss it too by a little (they fit the refitted surface, which takes them back).
+        cost.clear();
+        for (const std::uint32_t f : faces) {
+            const double k = facet_cost(c, s, f);
+            if (k > c.tol) cost.emplace_back(k, f);
+        }
+        std::sort(cost.begin(), cost.end(), std::greater<>());
         strays.clear();
-        for (const std::uint32_t f : faces) (facet_fits(c, s, f) ? rest : strays).push_back(f);
-        if (strays.empty() || strays.size() > limit) continue;
+        double stray_area = 0;
+        for (const auto& [k, f] : cost) {
+            if (stray_area + c.fd.area[f] > kStrayShare * total) continue;
+            strays.push_back(f);
+            stray_area += c.fd.area[f];
+        }
+        if (strays.empty()) continue;
+        std::sort(strays.begin(), strays.end());
+        rest.clear();
+        for (const std::uint32_t f : faces)
+            if (!std::binary_search(strays.begin(), strays.end(), f)) rest.push_back(f);
         auto r = fit_faces(c, rest, fit_kind_bit(s.kind));
         if (!r) continue;
         std::erase_if(strays, [&](std::uint32_t f) { return facet_fits(c, r->surface, f); });
@@ -632,6 +655,8 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
     std::vector<Surface> misses;
     std::vector<std::uint32_t> strays;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> homes;  // (stray facet, its region)
+    std::vector<std::uint32_t> orphans;                          // strays no neighbour takes
+    std::vector<Draft> groups;                                   // ... as new regions
     while (!pq.empty()) {
         const auto [cost, a, b, va, vb, exact] = pq.top();
         pq.pop();
@@ -659,19 +684,22 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
         misses.clear();
         auto r = fit_faces(c, faces, kinds, std::nullopt, &misses);
         homes.clear();
+        groups.clear();
         if (!r && !misses.empty()) {
             r = fit_without_strays(c, faces, misses, strays);
             // Strays are a few facets of one of the two, never the better part of either
             // (a region whose every facet fits elsewhere is not merged by leaving it out).
-            std::size_t from_a = 0;
-            for (const std::uint32_t f : strays) from_a += region[f] == a;
-            if (!strays.empty() && (2 * from_a >= drafts[a].faces.size() ||
-                                    2 * (strays.size() - from_a) >= drafts[b].faces.size())) {
-                r.reset();
-            }
+            double from_a = 0, from_b = 0, area_a = 0, area_b = 0;
+            for (const std::uint32_t f : strays) (region[f] == a ? from_a : from_b) += c.fd.area[f];
+            for (const std::uint32_t f : drafts[a].faces) area_a += c.fd.area[f];
+            for (const std::uint32_t f : drafts[b].faces) area_b += c.fd.area[f];
+            if (!strays.empty() && (2 * from_a >= area_a || 2 * from_b >= area_b)) r.reset();
             // Each stray goes to the neighbouring region (other than these two) that fits it
-            // best; with none, no merge.
+            // best. Those no neighbour takes (the corner beside them not yet fitted well) become
+            // regions of their own, one per connected group, each fitted; with none, no merge.
+            orphans.clear();
             for (const std::uint32_t f : strays) {
+                if (!r) break;
                 std::uint32_t best = kNone;
                 double best_cost = kInf;
                 for (const std::uint32_t g : c.fd.adj[f]) {
@@ -685,10 +713,37 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
                     }
                 }
                 if (best == kNone) {
+                    orphans.push_back(f);
+                } else {
+                    homes.emplace_back(f, best);
+                }
+            }
+            std::sort(orphans.begin(), orphans.end());
+            std::vector<std::uint8_t> taken(orphans.size(), 0);
+            for (std::size_t i = 0; r && i < orphans.size(); ++i) {
+                if (taken[i]) continue;
+                Draft d;
+                d.faces.push_back(orphans[i]);
+                taken[i] = 1;
+                for (std::size_t k = 0; k < d.faces.size(); ++k) {
+                    for (const std::uint32_t g : c.fd.adj[d.faces[k]]) {
+                        const auto it = std::lower_bound(orphans.begin(), orphans.end(), g);
+                        if (it == orphans.end() || *it != g) continue;
+                        const auto j = static_cast<std::size_t>(it - orphans.begin());
+                        if (taken[j]) continue;
+                        taken[j] = 1;
+                        d.faces.push_back(g);
+                    }
+                }
+                double group_area = 0;
+                for (const std::uint32_t f : d.faces) group_area += c.fd.area[f];
+                const auto fr = fit_faces(c, d.faces);
+                if (!fr || group_area > kOrphanShare * (area_a + area_b)) {
                     r.reset();
                     break;
                 }
-                homes.emplace_back(f, best);
+                d.surface = fr->surface;
+                groups.push_back(std::move(d));
             }
         }
         if (!r) continue;
@@ -700,6 +755,18 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
             region[f] = x;
             drafts[x].faces.push_back(f);
             ++version[x];
+        }
+        std::vector<std::uint32_t> born;  // the new regions of strays no neighbour took
+        for (Draft& d : groups) {
+            const auto id = static_cast<std::uint32_t>(drafts.size());
+            for (const std::uint32_t f : d.faces) {
+                std::erase(faces, f);
+                region[f] = id;
+            }
+            drafts.push_back(std::move(d));
+            version.push_back(0);
+            nbrs.emplace_back();
+            born.push_back(id);
         }
         std::sort(faces.begin(), faces.end());
         drafts[keep].faces = std::move(faces);
@@ -730,6 +797,20 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
         for (const std::uint32_t x : took) {
             for (const std::uint32_t y : nbrs[x])
                 if (y != keep) push(x, y);
+        }
+        for (const std::uint32_t id : born) {
+            std::vector<std::uint32_t> around;
+            for (const std::uint32_t f : drafts[id].faces)
+                for (const std::uint32_t g : c.fd.adj[f])
+                    if (g != kNone && region[g] != id && region[g] != kNone)
+                        around.push_back(region[g]);
+            std::sort(around.begin(), around.end());
+            around.erase(std::unique(around.begin(), around.end()), around.end());
+            nbrs[id] = around;
+            for (const std::uint32_t x : around) {
+                nbrs[x].insert(std::lower_bound(nbrs[x].begin(), nbrs[x].end(), id), id);
+                push(id, x);
+            }
         }
     }
     return merges;
