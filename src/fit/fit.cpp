@@ -1175,6 +1175,25 @@ FitResult fit_torus(const FitInput& in) {
     if (res.ok && in.accept > 0 && res.max <= in.accept) return res;
     TorusModel m2{};
     if (!spine_start(in, m2)) return res;
+    // Refined on the spine search's sample first: a torus that misses those points by more
+    // than the caller accepts does not hold them all (most of the unions a segmentation tries
+    // are no torus), and the sample is at most kSpineSamples points.
+    const std::size_t n = in.points.size(), step = std::max<std::size_t>(1, n / kSpineSamples);
+    if (step > 1 && in.accept > 0) {
+        std::vector<Vec3> sp, sn;
+        std::vector<double> sw;
+        for (std::size_t i = 0; i < n; i += step) {
+            sp.push_back(in.points[i]);
+            sn.push_back(in.normals[i]);
+            sw.push_back(weight(in, i));
+        }
+        FitInput sample = in;
+        sample.points = sp;
+        sample.normals = sn;
+        sample.weights = sw;
+        const FitResult first_look = refine_torus(m2, sample);
+        if (!first_look.ok || first_look.max > in.accept) return res;
+    }
     FitResult other = refine_torus(m2, in);
     if (!other.ok || spine_run(in, m2) < kSpineMinRun * m2.r) return res;
     return better_fit(other, res, in) ? other : res;
