@@ -701,16 +701,22 @@ FitResult failed(FitKind kind, std::string why) {
     return r;
 }
 
-FitResult fit_plane(const FitInput& in) {
-    double total = 0;
-    const Vec3 c = centroid(in, &total);
+/// The weighted principal axes of the points about g (eigenvalues ascending: column 0 is the
+/// normal of their mean plane).
+Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> principal_axes(const FitInput& in, Vec3 g) {
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
     for (std::size_t i = 0; i < in.points.size(); ++i) {
-        const Vec3 q = in.points[i] - c;
+        const Vec3 q = in.points[i] - g;
         const Eigen::Vector3d e(q.x, q.y, q.z);
         cov += weight(in, i) * e * e.transpose();
     }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov);
+}
+
+FitResult fit_plane(const FitInput& in) {
+    double total = 0;
+    const Vec3 c = centroid(in, &total);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es = principal_axes(in, c);
     if (es.info() != Eigen::Success || !(es.eigenvalues()(1) > 0)) {
         return failed(FitKind::kPlane, "the points are collinear or coincide");
     }
@@ -1026,50 +1032,48 @@ double spine_run(const FitInput& in, const TorusModel& m) {
     return std::fabs(m.R) * (2 * std::numbers::pi - gap);
 }
 
-/// The circle nearest the points s (weights w): its plane by principal components, the circle in
-/// it by Kasa's fit. Returns the weighted mean squared distance of s from it; infinite when
-/// there is none.
-double circle_through(const std::vector<Vec3>& s, const std::vector<double>& w, Vec3& c, Vec3& d,
-                      double& R) {
-    double tw = 0;
-    Vec3 g{};
-    for (std::size_t i = 0; i < s.size(); ++i) g += w[i] * s[i], tw += w[i];
-    if (!(tw > 0)) return kInf;
-    g = g / tw;
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        const Vec3 q = s[i] - g;
-        const Eigen::Vector3d e(q.x, q.y, q.z);
-        cov += w[i] * e * e.transpose();
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+/// The circle nearest the points: its plane by principal components, the circle in it by
+/// Kasa's fit (cylinder_along() the plane's normal). Returns the weighted mean squared distance
+/// of the points from it; infinite when there is none.
+double circle_through(const FitInput& in, Vec3& c, Vec3& d, double& R) {
+    double total = 0;
+    const Vec3 g = centroid(in, &total);
+    if (!(total > 0)) return kInf;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es = principal_axes(in, g);
     if (es.info() != Eigen::Success) return kInf;
     d = normalized(Vec3{es.eigenvectors()(0, 0), es.eigenvectors()(1, 0), es.eigenvectors()(2, 0)});
-    Vec3 u, v;
-    frame(d, u, v);
-    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        const Vec3 q = s[i] - g;
-        const double x = dot(q, u), y = dot(q, v);
-        const Eigen::Vector3d row(x, y, 1.0);
-        ata += w[i] * row * row.transpose();
-        atb -= w[i] * (x * x + y * y) * row;
-    }
-    const Eigen::Vector3d k = ata.ldlt().solve(atb);
-    const double cx = -0.5 * k(0), cy = -0.5 * k(1), R2 = cx * cx + cy * cy - k(2);
-    if (!k.allFinite() || !(R2 > 0)) return kInf;
-    R = std::sqrt(R2);
-    c = g + cx * u + cy * v;
+    CylinderModel m{};
+    if (!cylinder_along(in, d, m)) return kInf;
+    c = m.a.c;
+    R = m.r;
     double sum = 0;
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        const Vec3 q = s[i] - g;
-        const double h = dot(q, d), x = dot(q, u) - cx, y = dot(q, v) - cy;
-        const double e = std::hypot(x, y) - R;
-        sum += w[i] * (h * h + e * e);
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        const Vec3 q = in.points[i] - c;
+        const double h = dot(q, d), e = norm(q - h * d) - R;
+        sum += weight(in, i) * (h * h + e * e);
     }
-    return sum / tw;
+    return sum / total;
 }
+
+/// Every step-th point, normal and weight of an input, as an input of its own (`input()`).
+struct Strided {
+    std::vector<Vec3> points, normals;
+    std::vector<double> weights;
+    Strided(const FitInput& in, std::size_t step) {
+        for (std::size_t i = 0; i < in.points.size(); i += step) {
+            points.push_back(in.points[i]);
+            normals.push_back(in.normals[i]);
+            weights.push_back(weight(in, i));
+        }
+    }
+    FitInput input(const FitInput& like) const {
+        FitInput f = like;
+        f.points = points;
+        f.normals = normals;
+        f.weights = weights;
+        return f;
+    }
+};
 
 /// A second start for a torus, from its spine: the points moved along their normals by the
 /// tube radius lie on one circle (the tube's center line), whose plane's normal is the axis
@@ -1077,26 +1081,21 @@ double circle_through(const std::vector<Vec3>& s, const std::vector<double>& w, 
 /// outside the material, a round's inside) is the one that puts them closest to a circle.
 /// Where the first start fails: a patch of a few rows of a thin fillet ring, whose normals
 /// nearly all meet the tube's center line too, leaves the line that meets them all (the axis
-/// of the first start) to the mesh normals' errors.
-bool spine_start(const FitInput& in, TorusModel& m) {
-    const std::size_t n = in.points.size();
-    if (in.normals.size() != n || n < 8) return false;
-    const std::size_t step = std::max<std::size_t>(1, n / kSpineSamples);
-    std::vector<std::size_t> idx;
-    for (std::size_t i = 0; i < n; i += step) idx.push_back(i);
-    std::vector<double> w(idx.size());
-    for (std::size_t k = 0; k < idx.size(); ++k) w[k] = weight(in, idx[k]);
-    const Vec3 g = centroid(in);
+/// of the first start) to the mesh normals' errors. `sample`: the points searched with (at most
+/// kSpineSamples, with their normals); g: the centroid of all of them.
+bool spine_start(const FitInput& sample, Vec3 g, TorusModel& m) {
     double reach = 0;
-    for (const std::size_t i : idx) reach = std::max(reach, norm(in.points[i] - g));
+    for (const Vec3& p : sample.points) reach = std::max(reach, norm(p - g));
     if (!(reach > 0)) return false;
-    std::vector<Vec3> s(idx.size());
+    std::vector<Vec3> moved(sample.points.size());
+    FitInput spine = sample;
+    spine.points = moved;
     Vec3 c, d;
     double R = 0;
     const auto spread = [&](double rho) {
-        for (std::size_t k = 0; k < idx.size(); ++k)
-            s[k] = in.points[idx[k]] - rho * in.normals[idx[k]];
-        return circle_through(s, w, c, d, R);
+        for (std::size_t k = 0; k < moved.size(); ++k)
+            moved[k] = sample.points[k] - rho * sample.normals[k];
+        return circle_through(spine, c, d, R);
     };
     // The grid: radii of both signs, largest first; the best and its neighbours bracket it.
     std::vector<double> grid;
@@ -1173,24 +1172,17 @@ FitResult fit_torus(const FitInput& in) {
     FitResult res = refine_torus(m, in);
     // A fit within what the caller accepts stands; otherwise also from the spine.
     if (res.ok && in.accept > 0 && res.max <= in.accept) return res;
+    const std::size_t n = in.points.size();
+    if (in.normals.size() != n || n < 8) return res;
+    const std::size_t step = std::max<std::size_t>(1, n / kSpineSamples);
+    const Strided strided(in, step);
+    const FitInput sample = strided.input(in);
     TorusModel m2{};
-    if (!spine_start(in, m2)) return res;
+    if (!spine_start(sample, centroid(in), m2)) return res;
     // Refined on the spine search's sample first: a torus that misses those points by more
     // than the caller accepts does not hold them all (most of the unions a segmentation tries
     // are no torus), and the sample is at most kSpineSamples points.
-    const std::size_t n = in.points.size(), step = std::max<std::size_t>(1, n / kSpineSamples);
     if (step > 1 && in.accept > 0) {
-        std::vector<Vec3> sp, sn;
-        std::vector<double> sw;
-        for (std::size_t i = 0; i < n; i += step) {
-            sp.push_back(in.points[i]);
-            sn.push_back(in.normals[i]);
-            sw.push_back(weight(in, i));
-        }
-        FitInput sample = in;
-        sample.points = sp;
-        sample.normals = sn;
-        sample.weights = sw;
         const FitResult first_look = refine_torus(m2, sample);
         if (!first_look.ok || first_look.max > in.accept) return res;
     }

@@ -727,10 +727,13 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
             // Strays are a few facets of one of the two, never the better part of either
             // (a region whose every facet fits elsewhere is not merged by leaving it out).
             double from_a = 0, from_b = 0, area_a = 0, area_b = 0;
-            for (const std::uint32_t f : strays) (region[f] == a ? from_a : from_b) += c.fd.area[f];
-            for (const std::uint32_t f : drafts[a].faces) area_a += c.fd.area[f];
-            for (const std::uint32_t f : drafts[b].faces) area_b += c.fd.area[f];
-            if (!strays.empty() && (2 * from_a >= area_a || 2 * from_b >= area_b)) r.reset();
+            if (!strays.empty()) {  // (most refused unions have none: no sums for them)
+                for (const std::uint32_t f : strays)
+                    (region[f] == a ? from_a : from_b) += c.fd.area[f];
+                for (const std::uint32_t f : drafts[a].faces) area_a += c.fd.area[f];
+                for (const std::uint32_t f : drafts[b].faces) area_b += c.fd.area[f];
+                if (2 * from_a >= area_a || 2 * from_b >= area_b) r.reset();
+            }
             // Each stray goes to the neighbouring region (other than these two) that fits it
             // best. Those no neighbour takes (the corner beside them not yet fitted well) become
             // regions of their own, one per connected group, each fitted; with none, no merge.
