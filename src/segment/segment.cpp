@@ -47,6 +47,12 @@ constexpr double kFreeformRms = 2;
 /// Pieces of a group that are not chords of its B-spline are left out of it while they hold at
 /// most this share of its facets (see merge_freeform()).
 constexpr double kFreeformStrayShare = 0.02;
+/// An analytic face's vertices lie on its surface to the rounding of the file that carried
+/// them; a free-form face's analytic pieces fit only within the tolerance. A final region
+/// whose RMS residual passes this share of the chordal deflection is loose, a piece of a
+/// free-form face perhaps (see merge_loose_pieces()): the link rods' free-form faces' pieces
+/// are at 0.015-0.05, their tori and cylinders at most 0.003 (NIST parts' at 1e-5).
+constexpr double kLooseRms = 0.01;
 /// Vertices a region needs before a kind is fitted to it: one more than the kind's parameters
 /// (plane 3, sphere 4, cylinder 5, cone 6, torus 7), except the plane of a single facet. With
 /// no spare point any point set fits: the corners of a rectangle and a strip of its neighbour
@@ -904,6 +910,41 @@ Pieces measure_pieces(Context& c, const std::vector<Draft>& drafts,
     return out;
 }
 
+/// One B-spline for a group of pieces (`whole`: theirs together), held to the chordal
+/// deflection with a net of at most kFreeformMaxPoles; `ok` false otherwise.
+FitResult fit_group(Context& c, std::span<const std::uint32_t> faces, const Pieces& whole) {
+    PointSet ps;
+    c.gatherers.local().gather(c.m, c.fd, faces, ps);
+    // Unweighted: the smoothing term is scaled to the weights, and area weights (tiny
+    // near dense borders) let the net drift there (0.46 against 0.036 on a coarse die).
+    FitInput in{ps.points, ps.normals, {}};
+    // An extrusion is held to kFreeformRms x the pieces' RMS (extrusion_pays()): its profile
+    // gets the poles that takes, if it can...
+    in.rms_goal = kFreeformRms * whole.rms;
+    // ... and has fewer free parameters (2 per pole + 2) than they do.
+    in.max_profile_poles =
+        std::max(1, (static_cast<int>(std::min<std::size_t>(whole.parameters, 1u << 20)) - 3) / 2);
+    // A net is taken with at most kFreeformMaxPoles (below): none larger is fitted.
+    in.max_net_poles = kFreeformMaxPoles;
+    FitResult r = fit_bspline(in, c.sag);
+    if (r.ok &&
+        (r.max > c.sag || r.surface.bspline->num_u * r.surface.bspline->num_v > kFreeformMaxPoles))
+        r.ok = false;
+    return r;
+}
+
+/// An extrusion said in fewer numbers by its pieces: a chain of tangent analytic faces (the
+/// arcs and lines of a pocket's outline) is an extrusion too, its profile of many poles. (A
+/// height field's net is held by kFreeformMaxPoles: analytic pieces of a free-form face are
+/// few and large, and fewer numbers than its net.) And one that describes the points less
+/// closely than its pieces (kFreeformRms x their RMS): a CAD mesh's analytic faces lie on
+/// their surfaces to rounding, a free-form face's pieces only within the tolerance (without
+/// this, NIST CTC 01 and 03 lose a chain of coarse fillets to one extrusion:
+/// Segment.FindsTheFacesOfPrismaticCorpusParts).
+bool extrusion_pays(const FitResult& r, const Pieces& whole) {
+    return free_parameters(r.surface) < whole.parameters && r.rms <= kFreeformRms * whole.rms;
+}
+
 /// Groups of at least kFreeformMinPieces curved (non-plane) regions joined by smooth edges
 /// that one B-spline of at most kFreeformMaxPoles fits (an extrusion: with fewer free
 /// parameters than the pieces together, within kFreeformRms x their RMS) become one free-form
@@ -959,24 +1000,9 @@ std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
         std::vector<std::uint32_t> faces;
         for (const std::uint32_t r : g)
             faces.insert(faces.end(), drafts[r].faces.begin(), drafts[r].faces.end());
-        PointSet ps;
-        c.gatherers.local().gather(c.m, c.fd, faces, ps);
-        // Unweighted: the smoothing term is scaled to the weights, and area weights (tiny
-        // near dense borders) let the net drift there (0.46 against 0.036 on a coarse die).
-        FitInput in{ps.points, ps.normals, {}};
-        // An extrusion is held to kFreeformRms x the pieces' RMS (below): its profile gets the
-        // poles that takes, if it can.
         Pieces whole = measure_pieces(c, drafts, g);
-        in.rms_goal = kFreeformRms * whole.rms;
-        // ... and has fewer free parameters (2 per pole + 2) than they do.
-        in.max_profile_poles = std::max(
-            1, (static_cast<int>(std::min<std::size_t>(whole.parameters, 1u << 20)) - 3) / 2);
-        // A net is taken with at most kFreeformMaxPoles (below): none larger is fitted.
-        in.max_net_poles = kFreeformMaxPoles;
-        FitResult r = fit_bspline(in, c.sag);
-        if (!r.ok || r.max > c.sag ||
-            r.surface.bspline->num_u * r.surface.bspline->num_v > kFreeformMaxPoles)
-            continue;
+        FitResult r = fit_group(c, faces, whole);
+        if (!r.ok) continue;
         // Leftovers at a free-form face's rims (a few facets bridging it and its floor, grown
         // into a plane or a torus of their own) join the group through smooth edges but are no
         // chords of its surface: the group goes on without them, while they are a small part of
@@ -1005,18 +1031,9 @@ std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
                 faces.insert(faces.end(), drafts[p].faces.begin(), drafts[p].faces.end());
         }
         if (!chords_agree(c, r.surface, faces)) continue;
-        // An extrusion said in fewer numbers by its pieces: a chain of tangent analytic faces
-        // (the arcs and lines of a pocket's outline) is an extrusion too, its profile of many
-        // poles. (A height field's net is held by kFreeformMaxPoles: analytic pieces of a
-        // free-form face are few and large, and fewer numbers than its net.)
-        // And one that describes the points less closely than its pieces (kFreeformRms x their
-        // RMS): a CAD mesh's analytic faces lie on their surfaces to rounding, a free-form
-        // face's pieces only within the tolerance (without this, NIST CTC 01 and 03 lose a
-        // chain of coarse fillets to one extrusion: Segment.FindsTheFacesOfPrismaticCorpusParts).
         if (r.surface.bspline->extruded) {
             if (stray > 0) whole = measure_pieces(c, drafts, kept);
-            if (free_parameters(r.surface) >= whole.parameters || r.rms > kFreeformRms * whole.rms)
-                continue;
+            if (!extrusion_pays(r, whole)) continue;
         }
         std::sort(faces.begin(), faces.end());
         drafts[kept.front()].faces = std::move(faces);
@@ -1222,9 +1239,21 @@ Region final_region(Context& c, const Draft& d, std::span<const SurfaceRecord> r
     return out;
 }
 
-/// Regions numbered in the order of their first face; faces labelled; final fits.
-void finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRecord> records,
-            SegmentResult& result) {
+/// The noise of a segmentation: the RMS residual of its largest segmented analytic region within
+/// the tolerance (a CAD tessellation's is rounding; a noisy mesh's is the noise, somewhat less
+/// since the region kept only the vertices within the tolerance).
+double noise_level(std::span<const Region> regions) {
+    const Region* largest = nullptr;
+    for (const Region& g : regions) {
+        if (g.surface_index >= 0 || !g.within_tolerance || g.fit.surface.kind == FitKind::kBSpline)
+            continue;
+        if (largest == nullptr || g.facets > largest->facets) largest = &g;
+    }
+    return largest != nullptr ? largest->fit.rms : 0;
+}
+
+/// The live drafts (faces sorted), in the order of their first face.
+std::vector<std::uint32_t> live_drafts(std::vector<Draft>& drafts) {
     std::vector<std::uint32_t> order;
     for (std::uint32_t r = 0; r < drafts.size(); ++r) {
         if (drafts[r].alive && !drafts[r].faces.empty()) {
@@ -1235,15 +1264,142 @@ void finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRecor
     std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
         return drafts[a].faces.front() < drafts[b].faces.front();
     });
+    return order;
+}
+
+/// Free-form faces in many analytic pieces among exact analytic faces: merge_freeform() takes
+/// a smooth component whole, and a free-form blend between fillets (NIST FTC 10: six tori and
+/// three planes) or free-form faces tangent to each other round a part (link rods: 178
+/// pieces) are no one height field. Here, on the final fits: pieces that are loose (RMS over
+/// kLooseRms x the deflection: not an analytic face of the file) seed groups, largest first;
+/// a group takes its smooth neighbours that are loose or small (at most kSmallRegion facets:
+/// their fit says nothing), largest first, one by one while one B-spline (fit_group()) still
+/// fits it all. A group that leaves out a loose neighbour is no face but a patch of a larger
+/// free-form area (the link rods' faces, tangent to each other all round): its borders with
+/// the rest are tangent seams between two B-splines, where the B-rep finds no edge (19
+/// fallbacks and 5.8 deflections off on the link rods), and it stays in pieces. With
+/// kFreeformMinPieces curved pieces (a few planes of a facet or two between
+/// a fillet and its corner are no evidence: NIST FTC 07 lost the ends of fillets in strips to
+/// B-splines) it becomes one region. Exact analytic faces
+/// never join: a chain of fillets stays fillets. Returns the drafts that took a group.
+std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& drafts,
+                                              const std::vector<Region>& fitted) {
+    std::vector<std::uint32_t> merged;
+    const auto open = [&](std::uint32_t r) {
+        const Draft& d = drafts[r];
+        return d.alive && !d.faces.empty() && d.surface_index < 0 && fitted[r].fit.ok &&
+               fitted[r].fit.surface.kind != FitKind::kBSpline;
+    };
+    const auto seed = [&](std::uint32_t r) {
+        return open(r) && fitted[r].fit.rms > kLooseRms * c.sag;
+    };
+    const auto member = [&](std::uint32_t r) {
+        return seed(r) || (open(r) && drafts[r].faces.size() <= kSmallRegion);
+    };
+    std::vector<std::uint32_t> seeds;
+    for (std::uint32_t r = 0; r < drafts.size(); ++r)
+        if (seed(r)) seeds.push_back(r);
+    if (seeds.size() < 2) return merged;
+    const std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
+    for (const auto& [a, b] : adjacent_pairs(c, region, true)) {
+        if (!member(a) || !member(b)) continue;
+        nbrs[a].push_back(b);
+        nbrs[b].push_back(a);
+    }
+    const auto larger = [&](std::uint32_t a, std::uint32_t b) {
+        const std::size_t na = drafts[a].faces.size(), nb = drafts[b].faces.size();
+        return na != nb ? na > nb : a < b;
+    };
+    std::sort(seeds.begin(), seeds.end(), larger);
+    std::vector<std::uint8_t> taken(drafts.size(), 0);
+    std::vector<std::uint32_t> mark(drafts.size(), kNone);  // last seed that met it
+    for (const std::uint32_t s : seeds) {
+        if (taken[s] || nbrs[s].empty()) continue;
+        std::vector<std::uint32_t> group{s}, frontier;
+        mark[s] = s;
+        const auto reach = [&](std::uint32_t r) {
+            for (const std::uint32_t n : nbrs[r]) {
+                if (taken[n] || mark[n] == s) continue;
+                mark[n] = s;
+                frontier.push_back(n);
+            }
+        };
+        reach(s);
+        std::vector<std::uint32_t> faces = drafts[s].faces;
+        FitResult best;
+        bool bounded = true;  // no loose neighbour left out
+        while (!frontier.empty()) {
+            const auto it = std::min_element(frontier.begin(), frontier.end(), larger);
+            const std::uint32_t n = *it;
+            frontier.erase(it);
+            std::vector<std::uint32_t> more = faces;
+            more.insert(more.end(), drafts[n].faces.begin(), drafts[n].faces.end());
+            group.push_back(n);
+            Pieces whole;
+            for (const std::uint32_t p : group) {
+                whole.parameters += free_parameters(fitted[p].fit.surface);
+                whole.rms = std::max(whole.rms, fitted[p].fit.rms);
+            }
+            FitResult r = fit_group(c, more, whole);
+            if (r.ok && chords_agree(c, r.surface, more) &&
+                (!r.surface.bspline->extruded || extrusion_pays(r, whole))) {
+                faces = std::move(more);
+                best = std::move(r);
+                reach(n);
+            } else {
+                group.pop_back();
+                bounded = bounded && !seed(n);
+            }
+        }
+        if (!bounded) continue;
+        const auto curved = std::count_if(group.begin(), group.end(), [&](std::uint32_t p) {
+            return fitted[p].fit.surface.kind != FitKind::kPlane;
+        });
+        if (static_cast<std::size_t>(curved) < kFreeformMinPieces) continue;
+        std::sort(faces.begin(), faces.end());
+        drafts[s].faces = std::move(faces);
+        drafts[s].surface = best.surface;
+        for (const std::uint32_t p : group) {
+            taken[p] = 1;
+            if (p == s) continue;
+            drafts[p].alive = false;
+            drafts[p].faces.clear();
+        }
+        merged.push_back(s);
+    }
+    return merged;
+}
+
+/// Regions numbered in the order of their first face; faces labelled; final fits. With
+/// `loose`, free-form faces in loose pieces are merged on the way (merge_loose_pieces()).
+/// Returns the noise (noise_level()) of the regions before that: a free-form face merged from
+/// noisy pieces would hide it.
+double finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRecord> records,
+              SegmentResult& result, bool loose) {
+    std::vector<std::uint32_t> order = live_drafts(drafts);
+    std::vector<Region> fitted(drafts.size());
+    tbb::parallel_for(std::size_t{0}, order.size(), [&](std::size_t i) {
+        fitted[order[i]] = final_region(c, drafts[order[i]], records);
+    });
+    const double noise = noise_level(fitted);
+    if (loose) {
+        const std::vector<std::uint32_t> merged = merge_loose_pieces(c, drafts, fitted);
+        result.freeform_groups += merged.size();
+        tbb::parallel_for(std::size_t{0}, merged.size(), [&](std::size_t i) {
+            fitted[merged[i]] = final_region(c, drafts[merged[i]], records);
+        });
+        if (!merged.empty()) order = live_drafts(drafts);
+    }
     result.region = FaceMap<std::int32_t>(c.m.num_faces(), -1);
     result.regions.resize(order.size());
-    tbb::parallel_for(std::size_t{0}, order.size(), [&](std::size_t i) {
-        result.regions[i] = final_region(c, drafts[order[i]], records);
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        result.regions[i] = std::move(fitted[order[i]]);
         result.regions[i].id = static_cast<std::int32_t>(i);
-    });
-    for (std::size_t i = 0; i < order.size(); ++i)
         for (const std::uint32_t f : drafts[order[i]].faces)
             result.region[fid(f)] = static_cast<std::int32_t>(i);
+    }
+    return noise;
 }
 
 /// One draft per SRE surface index present; mask[f] = 1 for the faces left to segment.
@@ -1354,8 +1510,9 @@ double default_segment_tolerance(const Mesh& m, std::string* rule) {
 namespace {
 
 /// One segmentation at tolerance `tol` (see segment()).
+/// One segmentation at tolerance `tol`; `noise` receives its noise (finish()).
 SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double tol,
-                          std::string rule, const ProgressFn& progress) {
+                          std::string rule, const ProgressFn& progress, double& noise) {
     const auto t0 = Clock::now();
     SegmentResult result;
     result.method = options.method;
@@ -1419,23 +1576,10 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
     if (progress) progress("segment", 1.0);
     const auto tf = Clock::now();
     if (progress) progress("fit", 0.0);
-    finish(c, drafts, options.surfaces, result);
+    noise = finish(c, drafts, options.surfaces, result, options.method == SegmentMethod::kFacets);
     result.fit_seconds = seconds_since(tf);
     if (progress) progress("fit", 1.0);
     return result;
-}
-
-/// The noise of a segmentation: the RMS residual of its largest segmented analytic region within
-/// the tolerance (a CAD tessellation's is rounding; a noisy mesh's is the noise, somewhat less
-/// since the region kept only the vertices within the tolerance).
-double noise_level(const SegmentResult& r) {
-    const Region* largest = nullptr;
-    for (const Region& g : r.regions) {
-        if (g.surface_index >= 0 || !g.within_tolerance || g.fit.surface.kind == FitKind::kBSpline)
-            continue;
-        if (largest == nullptr || g.facets > largest->facets) largest = &g;
-    }
-    return largest != nullptr ? largest->fit.rms : 0;
 }
 
 }  // namespace
@@ -1445,10 +1589,12 @@ Result<SegmentResult> segment(const Mesh& m, const SegmentOptions& options,
     if (!std::isfinite(options.tolerance) || !std::isfinite(options.sharp_angle)) {
         return Error{ErrorCode::kBadValue, "tolerance and sharp angle must be finite", {}, -1, -1};
     }
-    if (options.tolerance > 0) return run_segment(m, options, options.tolerance, "given", progress);
+    double sigma = 0;
+    if (options.tolerance > 0)
+        return run_segment(m, options, options.tolerance, "given", progress, sigma);
     std::string rule;
     double tol = default_segment_tolerance(m, &rule);
-    SegmentResult r = run_segment(m, options, tol, rule, progress);
+    SegmentResult r = run_segment(m, options, tol, rule, progress, sigma);
     // A noisy mesh: its vertices stray from their surfaces by more than the size-derived
     // tolerance allows, and the faces break up. Segment again at kNoiseFactor x the noise the
     // first pass measured (a few passes: a region that kept only the vertices within the
@@ -1456,14 +1602,13 @@ Result<SegmentResult> segment(const Mesh& m, const SegmentOptions& options,
     double seconds = r.curvature_seconds + r.segment_seconds + r.fit_seconds;
     // (The facets method's: the paper's regions are too loose a measure of the noise.)
     for (int pass = 0; pass < kNoisePasses && options.method == SegmentMethod::kFacets; ++pass) {
-        const double sigma = noise_level(r);
         if (!(kNoiseFactor * sigma > tol)) break;
         tol = kNoiseFactor * sigma;
         char buf[160];
         std::snprintf(buf, sizeof buf,
                       "%g x the noise (RMS %.3g of the largest region, segmented again)",
                       kNoiseFactor, sigma);
-        r = run_segment(m, options, tol, buf, progress);
+        r = run_segment(m, options, tol, buf, progress, sigma);
         r.segment_seconds += seconds;  // the earlier passes count
         seconds = r.curvature_seconds + r.segment_seconds + r.fit_seconds;
     }
