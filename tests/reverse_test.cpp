@@ -644,6 +644,43 @@ TEST(ReverseSurfaces, AFreeFormBlendAmongFilletsIsOneFace) {
     EXPECT_LE(seg.regions.size(), 214u * 105 / 100);
 }
 
+// NIST FTC 08's bosses have corners rounded at 3.05 and a fillet of 1.52 at their base: round
+// each corner the fillet is a torus of radii 4.57 and 1.52 (90 facets). A piece of it fits
+// other tori within the tolerance (one of 5.31 and 3.83 took half of it) and the fillets took
+// the rest: four tori in four pieces each, and six faces that failed. A torus between two
+// fillets with perpendicular axes is now the one they make (corner_tori()).
+TEST(ReverseSurfaces, CornerToriAreTheOnesTheirFilletsMake) {
+    if (corpus_steps().empty()) GTEST_SKIP() << "no corpus at " << corpus_step_dir();
+    const SamplePart part = corpus_part(corpus_step_dir() / "nist_ftc_08_asme1_rc.stp");
+    const Mesh mesh = build_mesh(part.mesh).value().mesh;
+    const SegmentResult seg = segment(mesh).value();
+    std::map<std::pair<std::int64_t, std::int32_t>, double> both;
+    std::map<std::int64_t, double> face_area;
+    for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+        const FaceId ff(static_cast<std::uint32_t>(f));
+        both[{mesh.cuts()[f], seg.region[ff]}] += mesh.face_area(ff);
+        face_area[mesh.cuts()[f]] += mesh.face_area(ff);
+    }
+    std::size_t tori = 0;
+    for (std::size_t t = 0; t < part.faces.size(); ++t) {
+        if (part.faces[t].kind != "torus") continue;
+        ++tori;
+        const auto key = static_cast<std::int64_t>(t);
+        double most = 0;
+        std::int32_t region = -1;
+        for (const auto& [k, a] : both) {
+            if (k.first == key && a > most) std::tie(most, region) = std::pair{a, k.second};
+        }
+        ASSERT_GE(region, 0) << "true face " << t;
+        EXPECT_GE(most, 0.8 * face_area[key]) << "true face " << t;  // was half
+        EXPECT_EQ(seg.regions[static_cast<std::size_t>(region)].fit.surface.kind, FitKind::kTorus)
+            << "true face " << t;
+    }
+    EXPECT_GE(tori, 4u);
+    const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "corner_tori");
+    EXPECT_TRUE(o.report.fallbacks.empty());
+}
+
 // NIST CTC 02's drafted walls (cones of radius 101 mm at 3 degrees, δ 1.17 mm) are meshed in
 // facets from rim to rim whose middles sag 1.6 x the estimated deflection: each facet was a
 // plane region of its own, 180 of them on four cones. A cone or cylinder may take a region of

@@ -1047,6 +1047,85 @@ std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
     return replaced;
 }
 
+/// Two axes this close to perpendicular (sine of the angle from 90 degrees) may carry the
+/// fillets a corner torus joins: a vertical fillet round a pocket's corner and the floor fillet
+/// beside it. CAD places them exactly; a fitted axis is off by a few thousandths.
+constexpr double kCornerAxesSine = 0.01;
+
+/// The torus where two fillets meet at a corner (see corner_tori()): about `a`'s axis, through
+/// the point of it nearest `b`'s axis, its spine at the distance between the two axes, its tube
+/// `b`'s radius. False when the axes are not perpendicular or meet.
+bool corner_torus(const Surface& a, const Surface& b, Surface& out) {
+    const Vec3 da = normalized(a.axis), db = normalized(b.axis);
+    if (std::fabs(dot(da, db)) > kCornerAxesSine) return false;
+    // The nearest points of the two lines: b's axis runs across a's, so the foot on a's axis
+    // of b's is where a's axis meets the plane through b's axis normal to their common normal.
+    const Vec3 n = cross(da, db);
+    const double nn = dot(n, n);
+    if (!(nn > 0)) return false;
+    const Vec3 w = b.point - a.point;
+    const double ta = dot(cross(w, db), n) / nn;  // along a's axis
+    const Vec3 center = a.point + ta * da;
+    const double spine = std::fabs(dot(w, n)) / std::sqrt(nn);
+    if (!(spine > 0)) return false;
+    out = Surface{};
+    out.kind = FitKind::kTorus;
+    out.point = center;
+    out.axis = da;
+    out.radius = spine;
+    out.minor_radius = b.radius;
+    return true;
+}
+
+/// A corner torus between two fillets (a pocket's vertical corner fillet and its floor fillet)
+/// is known from them: its axis the first's, its tube the second's, its spine as far from the
+/// axis as the two axes are apart. A small piece of a torus fits many tori within the
+/// tolerance, and the fillets, tangent to it, grow into it: NIST FTC 08's four corners (a
+/// torus of radii 4.57 and 1.52) came back as a torus of 5.31 and 3.83 over half of each,
+/// cylinders over the rest, and faces that failed. A curved region smoothly joined to two
+/// cylinders whose axes are perpendicular takes the torus they make when every vertex of it
+/// lies on that within the tolerance and its facets are chords of it; border refinement then
+/// gives it back the facets the fillets took. Returns the regions that took one.
+std::uint64_t corner_tori(Context& c, std::vector<Draft>& drafts) {
+    const std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
+    for (const auto& [a, b] : adjacent_pairs(c, region, true)) {
+        nbrs[a].push_back(b);
+        nbrs[b].push_back(a);
+    }
+    const auto cylinder = [&](std::uint32_t r) {
+        return drafts[r].alive && drafts[r].surface.kind == FitKind::kCylinder;
+    };
+    std::uint64_t taken = 0;
+    PointSet ps;
+    for (std::uint32_t t = 0; t < drafts.size(); ++t) {
+        Draft& d = drafts[t];
+        if (!d.alive || d.surface_index >= 0 || d.faces.empty() ||
+            (d.surface.kind != FitKind::kTorus && d.surface.kind != FitKind::kSphere))
+            continue;
+        std::vector<std::uint32_t> cyl;
+        for (const std::uint32_t n : nbrs[t])
+            if (cylinder(n)) cyl.push_back(n);
+        if (cyl.size() < 2) continue;
+        c.gatherers.local().gather(c.m, c.fd, d.faces, ps);
+        std::optional<FitResult> best;
+        for (std::size_t i = 0; i < cyl.size(); ++i) {
+            for (std::size_t j = 0; j < cyl.size(); ++j) {
+                Surface h;
+                if (i == j || !corner_torus(drafts[cyl[i]].surface, drafts[cyl[j]].surface, h))
+                    continue;
+                FitResult r = residuals(h, ps.input());
+                if (!(r.max <= c.tol) || !chords_agree(c, h, d.faces)) continue;
+                if (!best || r.rms < best->rms) best = std::move(r);
+            }
+        }
+        if (!best) continue;
+        d.surface = best->surface;
+        ++taken;
+    }
+    return taken;
+}
+
 /// Small regions whose facets each fit a neighbouring region's surface are dissolved into
 /// them: the leftovers of growing where three faces meet (a facet of the fillet and one of the
 /// corner torus, coplanar within the tolerance, grown together as a plane). So are a larger
@@ -1567,6 +1646,7 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
     result.freeform_groups = merge_freeform(c, drafts);
     // Border refinement is the facets method's (the paper assigns facets from their vertices).
     if (options.method == SegmentMethod::kFacets) {
+        corner_tori(c, drafts);
         result.reassigned_facets = absorb_small_regions(c, drafts);
         result.reassigned_facets += refine_borders(c, drafts);
         // Refining can leave a few facets of two faces on their own again.
