@@ -1428,7 +1428,8 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
                 reach(n);
             } else {
                 group.pop_back();
-                bounded = bounded && !seed(n);
+                bounded = !seed(n);
+                if (!bounded) break;  // refused whatever else it takes
             }
         }
         if (!bounded) continue;
