@@ -605,6 +605,50 @@ TEST(ReverseSurfaces, CoarseFilletsFaceForFace) {
     }
 }
 
+/// Of each true face of `part` of kind `kind`: the region holding most of its area, and the
+/// share of the face's area that region holds.
+struct MainRegion {
+    std::size_t face = 0;
+    std::int32_t region = -1;
+    double share = 0;
+};
+std::vector<MainRegion> main_regions(const SamplePart& part, const Mesh& mesh,
+                                     const SegmentResult& seg, const std::string& kind) {
+    std::map<std::pair<std::int64_t, std::int32_t>, double> both;
+    std::map<std::int64_t, double> face_area;
+    for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+        const FaceId ff(static_cast<std::uint32_t>(f));
+        both[{mesh.cuts()[f], seg.region[ff]}] += mesh.face_area(ff);
+        face_area[mesh.cuts()[f]] += mesh.face_area(ff);
+    }
+    std::vector<MainRegion> out;
+    for (std::size_t t = 0; t < part.faces.size(); ++t) {
+        if (part.faces[t].kind != kind) continue;
+        const auto key = static_cast<std::int64_t>(t);
+        MainRegion m{t, -1, 0};
+        for (const auto& [k, a] : both) {
+            if (k.first == key && a > m.share) m.share = a, m.region = k.second;
+        }
+        if (face_area[key] > 0) m.share /= face_area[key];
+        out.push_back(m);
+    }
+    return out;
+}
+
+/// Expects each true face of `kind` mostly (`share` of its area) in one region of that kind;
+/// returns how many there are.
+std::size_t expect_one_region_each(const SamplePart& part, const Mesh& mesh,
+                                   const SegmentResult& seg, FitKind kind, double share) {
+    const std::vector<MainRegion> faces = main_regions(part, mesh, seg, to_string(kind));
+    for (const MainRegion& m : faces) {
+        EXPECT_GE(m.share, share) << "true face " << m.face;
+        if (m.region < 0) continue;
+        EXPECT_EQ(seg.regions[static_cast<std::size_t>(m.region)].fit.surface.kind, kind)
+            << "true face " << m.face;
+    }
+    return faces.size();
+}
+
 // NIST FTC 10's free-form blend (20.8 mm2 of B-spline between fillets of radius 1 and 13) was
 // six tori and three planes: one B-spline fits them, but merge_freeform() takes the smooth
 // component whole, 156 pieces of fillets round the part. Its loose pieces are now grown into
@@ -615,29 +659,7 @@ TEST(ReverseSurfaces, AFreeFormBlendAmongFilletsIsOneFace) {
     const SamplePart part = corpus_part(corpus_step_dir() / "nist_ftc_10_asme1_rb.stp");
     const Mesh mesh = build_mesh(part.mesh).value().mesh;
     const SegmentResult seg = segment(mesh).value();
-    std::map<std::pair<std::int64_t, std::int32_t>, double> both;
-    std::map<std::int64_t, double> face_area;
-    for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
-        const FaceId ff(static_cast<std::uint32_t>(f));
-        both[{mesh.cuts()[f], seg.region[ff]}] += mesh.face_area(ff);
-        face_area[mesh.cuts()[f]] += mesh.face_area(ff);
-    }
-    std::size_t blends = 0;
-    for (std::size_t t = 0; t < part.faces.size(); ++t) {
-        if (part.faces[t].kind != "bspline") continue;
-        ++blends;
-        const auto key = static_cast<std::int64_t>(t);
-        double most = 0;
-        std::int32_t region = -1;
-        for (const auto& [k, a] : both) {
-            if (k.first == key && a > most) std::tie(most, region) = std::pair{a, k.second};
-        }
-        ASSERT_GE(region, 0) << "true face " << t;
-        EXPECT_GE(most, kMatchShare * face_area[key]) << "true face " << t;
-        EXPECT_EQ(seg.regions[static_cast<std::size_t>(region)].fit.surface.kind, FitKind::kBSpline)
-            << "true face " << t;
-    }
-    EXPECT_EQ(blends, 1u);
+    EXPECT_EQ(expect_one_region_each(part, mesh, seg, FitKind::kBSpline, kMatchShare), 1u);
     std::size_t bsplines = 0;
     for (const Region& g : seg.regions) bsplines += g.fit.surface.kind == FitKind::kBSpline;
     EXPECT_EQ(bsplines, 1u);  // no fillet taken for one
@@ -654,29 +676,7 @@ TEST(ReverseSurfaces, CornerToriAreTheOnesTheirFilletsMake) {
     const SamplePart part = corpus_part(corpus_step_dir() / "nist_ftc_08_asme1_rc.stp");
     const Mesh mesh = build_mesh(part.mesh).value().mesh;
     const SegmentResult seg = segment(mesh).value();
-    std::map<std::pair<std::int64_t, std::int32_t>, double> both;
-    std::map<std::int64_t, double> face_area;
-    for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
-        const FaceId ff(static_cast<std::uint32_t>(f));
-        both[{mesh.cuts()[f], seg.region[ff]}] += mesh.face_area(ff);
-        face_area[mesh.cuts()[f]] += mesh.face_area(ff);
-    }
-    std::size_t tori = 0;
-    for (std::size_t t = 0; t < part.faces.size(); ++t) {
-        if (part.faces[t].kind != "torus") continue;
-        ++tori;
-        const auto key = static_cast<std::int64_t>(t);
-        double most = 0;
-        std::int32_t region = -1;
-        for (const auto& [k, a] : both) {
-            if (k.first == key && a > most) std::tie(most, region) = std::pair{a, k.second};
-        }
-        ASSERT_GE(region, 0) << "true face " << t;
-        EXPECT_GE(most, 0.8 * face_area[key]) << "true face " << t;  // was half
-        EXPECT_EQ(seg.regions[static_cast<std::size_t>(region)].fit.surface.kind, FitKind::kTorus)
-            << "true face " << t;
-    }
-    EXPECT_GE(tori, 4u);
+    EXPECT_GE(expect_one_region_each(part, mesh, seg, FitKind::kTorus, 0.8), 4u);  // was half
     const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "corner_tori");
     EXPECT_TRUE(o.report.fallbacks.empty());
 }
