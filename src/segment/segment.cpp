@@ -1077,6 +1077,26 @@ bool corner_torus(const Surface& a, const Surface& b, Surface& out) {
     return true;
 }
 
+/// The ball where two fillets of one radius meet, their axes crossing: about the crossing, of
+/// their radius. False when the axes are near parallel, pass apart or the radii differ (by
+/// more than `tol`).
+bool corner_sphere(const Surface& a, const Surface& b, double tol, Surface& out) {
+    const Vec3 da = normalized(a.axis), db = normalized(b.axis);
+    const Vec3 n = cross(da, db);
+    const double nn = dot(n, n);
+    if (!(nn > kCornerAxesSine * kCornerAxesSine) || std::fabs(a.radius - b.radius) > tol)
+        return false;
+    const Vec3 w = b.point - a.point;
+    if (std::fabs(dot(w, n)) / std::sqrt(nn) > tol) return false;
+    const Vec3 pa = a.point + (dot(cross(w, db), n) / nn) * da;
+    const Vec3 pb = b.point + (dot(cross(w, da), n) / nn) * db;
+    out = Surface{};
+    out.kind = FitKind::kSphere;
+    out.point = 0.5 * (pa + pb);
+    out.radius = 0.5 * (a.radius + b.radius);
+    return true;
+}
+
 /// A corner torus between two fillets (a pocket's vertical corner fillet and its floor fillet)
 /// is known from them: its axis the first's, its tube the second's, its spine as far from the
 /// axis as the two axes are apart. A small piece of a torus fits many tori within the
@@ -1101,7 +1121,8 @@ std::uint64_t corner_tori(Context& c, std::vector<Draft>& drafts) {
     for (std::uint32_t t = 0; t < drafts.size(); ++t) {
         Draft& d = drafts[t];
         if (!d.alive || d.surface_index >= 0 || d.faces.empty() ||
-            (d.surface.kind != FitKind::kTorus && d.surface.kind != FitKind::kSphere))
+            (d.surface.kind != FitKind::kTorus && d.surface.kind != FitKind::kSphere &&
+             d.surface.kind != FitKind::kCone))
             continue;
         std::vector<std::uint32_t> cyl;
         for (const std::uint32_t n : nbrs[t])
@@ -1111,12 +1132,17 @@ std::uint64_t corner_tori(Context& c, std::vector<Draft>& drafts) {
         std::optional<FitResult> best;
         for (std::size_t i = 0; i < cyl.size(); ++i) {
             for (std::size_t j = 0; j < cyl.size(); ++j) {
-                Surface h;
-                if (i == j || !corner_torus(drafts[cyl[i]].surface, drafts[cyl[j]].surface, h))
-                    continue;
-                FitResult r = residuals(h, ps.input());
-                if (!(r.max <= c.tol) || !chords_agree(c, h, d.faces)) continue;
-                if (!best || r.rms < best->rms) best = std::move(r);
+                if (i == j) continue;
+                const Surface& a = drafts[cyl[i]].surface;
+                const Surface& b = drafts[cyl[j]].surface;
+                for (int k = 0; k < 2; ++k) {
+                    Surface h;
+                    if (k == 0 ? !corner_torus(a, b, h) : (i > j || !corner_sphere(a, b, c.tol, h)))
+                        continue;
+                    FitResult r = residuals(h, ps.input());
+                    if (!(r.max <= c.tol) || !chords_agree(c, h, d.faces)) continue;
+                    if (!best || r.rms < best->rms) best = std::move(r);
+                }
             }
         }
         if (!best) continue;
