@@ -596,7 +596,7 @@ FaceMatch match_faces(const SamplePart& part, bool list = false) {
 // per strip; rings of fillets about rounded corners in ten pieces), FTC 07 200 of 269 (its
 // 232 mm fillets' strips beside a few small facets of their end tori): strays left to their
 // neighbours or to regions of their own, and the tori's spine start (docs/segmentation.md); one
-// of FTC 07's corner balls is the sphere its two fillets make (corner_tori(): 227 -> 228).
+// of FTC 07's corner balls is the sphere its two fillets make (corner_surfaces(): 227 -> 228).
 TEST(ReverseSurfaces, CoarseFilletsFaceForFace) {
     if (corpus_steps().empty()) GTEST_SKIP() << "no corpus at " << corpus_step_dir();
     for (const auto& [name, matched] : {std::pair{"nist_ftc_10_asme1_rb.stp", 212u},
@@ -671,14 +671,14 @@ TEST(ReverseSurfaces, AFreeFormBlendAmongFilletsIsOneFace) {
 // each corner the fillet is a torus of radii 4.57 and 1.52 (90 facets). A piece of it fits
 // other tori within the tolerance (one of 5.31 and 3.83 took half of it) and the fillets took
 // the rest: four tori in four pieces each, and six faces that failed. A torus between two
-// fillets with perpendicular axes is now the one they make (corner_tori()).
+// fillets with perpendicular axes is now the one they make (corner_surfaces()).
 TEST(ReverseSurfaces, CornerToriAreTheOnesTheirFilletsMake) {
     if (corpus_steps().empty()) GTEST_SKIP() << "no corpus at " << corpus_step_dir();
     const SamplePart part = corpus_part(corpus_step_dir() / "nist_ftc_08_asme1_rc.stp");
     const Mesh mesh = build_mesh(part.mesh).value().mesh;
     const SegmentResult seg = segment(mesh).value();
     EXPECT_GE(expect_one_region_each(part, mesh, seg, FitKind::kTorus, 0.8), 4u);  // was half
-    const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "corner_tori");
+    const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "corner_surfaces");
     EXPECT_TRUE(o.report.fallbacks.empty());
 }
 
