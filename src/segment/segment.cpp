@@ -658,14 +658,19 @@ std::optional<FitResult> fit_without_strays(Context& c, std::span<const std::uin
 }
 
 /// Merges adjacent regions that one analytic surface fits, most alike pair first (method.md
-/// 3.6); the merged region keeps the larger one's index. Returns the number of merges.
+/// 3.6); the merged region keeps the larger one's index. Returns the number of merges. With
+/// `fragments`, only pairs one of which lies within the tolerance of the other's surface
+/// (unlikeness() at most the tolerance): the pass after border refinement, which must not
+/// reopen what the first pass refused (FTC 08: a cylinder face beside its fillet, both taken
+/// by one torus within the tolerance, the cylinder's vertices 4 x the tolerance off the
+/// torus's own fit).
 ///
 /// A union that one surface fits but for a few facets on its border (fit_without_strays())
 /// merges too, those facets going to the neighbouring region that fits them best: a facet of
 /// a corner patch that the growing took into a strip of a coarse fillet (it lies within the
 /// tolerance of the strip's plane, not of the fillet's cylinder) would otherwise keep the
 /// fillet in one plane per strip.
-std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
+std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragments = false) {
     std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
     // Across sharp edges too (a coarse fillet's facets meet at more than the sharp angle): a
     // surface through the corners of two faces meeting at a crease (a prism's sides lie on
@@ -708,6 +713,8 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts) {
             pq.emplace(unlikeness(c, drafts[a], drafts[b]), a, b, va, vb, true);
             continue;
         }
+        // Fragments: every pair left is one neither of whose surfaces takes the other.
+        if (fragments && cost > c.tol) break;
         std::vector<std::uint32_t> faces = drafts[a].faces;
         faces.insert(faces.end(), drafts[b].faces.begin(), drafts[b].faces.end());
         // A much larger region keeps its kind (and may take a firm plane that is its chords: a
@@ -1676,6 +1683,9 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
         result.reassigned_facets += refine_borders(c, drafts);
         // Refining can leave a few facets of two faces on their own again.
         result.reassigned_facets += absorb_small_regions(c, drafts);
+        // Refining moved facets between regions after the merging: a fragment that one of its
+        // neighbours' surfaces takes as it is joins it (CTC 04: 427 -> 421 faces).
+        result.merges += merge_regions(c, drafts, /*fragments=*/true);
     }
     result.segment_seconds = seconds_since(t0) - result.curvature_seconds;
     if (progress) progress("segment", 1.0);
