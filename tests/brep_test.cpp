@@ -15,6 +15,7 @@
 #include <BRepGProp.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeRevol.hxx>
 #include <BRep_Tool.hxx>
 #include <GC_MakeArcOfCircle.hxx>
@@ -384,6 +385,51 @@ TEST(Reverse, ThinFilletRingsAreTori) {
             EXPECT_NEAR(g.fit.surface.minor_radius, 1.0, 1e-3) << angular;
         }
         EXPECT_GE(tori, 8) << angular;
+    }
+}
+
+// A disk of radius 140 with its top edge rounded at 6.35 (NIST CTC 05's large fillets): at
+// coarse deflections BRepMesh meshes the fillet's torus (R 133.65) in fans whose middles sag
+// past the deflection estimate, and strips of it grew as cylinders of radius 6.35 that the
+// torus, refitted with them, refused (9 regions for 4 faces at 0.9 mm, 20 degrees). Each
+// strip lies on the torus to rounding and its facets are chords of it (chord_fits()): it
+// joins. The top plane, every corner on the rim its fillet meets, must not: no chord of the
+// torus's tube sags 60 mm.
+TEST(Reverse, AFilletOfLargeRadiusMeshedInFansIsOneTorus) {
+    const TopoDS_Shape disk = BRepPrimAPI_MakeCylinder(140, 30).Shape();
+    BRepFilletAPI_MakeFillet fillet(disk);
+    for (TopExp_Explorer x(disk, TopAbs_EDGE); x.More(); x.Next()) {
+        const TopoDS_Edge& e = TopoDS::Edge(x.Current());
+        TopoDS_Vertex v1, v2;
+        TopExp::Vertices(e, v1, v2);
+        if (!BRep_Tool::Degenerated(e) && BRep_Tool::Pnt(v1).Z() > 29 &&
+            BRep_Tool::Pnt(v2).Z() > 29)
+            fillet.Add(6.35, e);
+    }
+    const TopoDS_Shape shape = fillet.Shape();
+    ASSERT_EQ(count_faces(shape), 4u);
+    for (const double deflection : {0.3, 0.6, 0.9, 1.2}) {
+        for (const double angular : {0.35, 0.5}) {
+            const Mesh mesh = heal(tessellate(shape, deflection, angular));
+            const Result<SegmentResult> seg = segment(mesh);
+            ASSERT_TRUE(seg.ok());
+            EXPECT_EQ(seg->regions.size(), 4u) << deflection << " " << angular;
+            const auto kinds = region_kinds(seg.value());
+            EXPECT_EQ(kinds.count("plane") ? kinds.at("plane") : 0, 2) << deflection;
+            EXPECT_EQ(kinds.count("torus") ? kinds.at("torus") : 0, 1) << deflection;
+            for (const Region& g : seg->regions) {
+                if (g.fit.surface.kind != FitKind::kTorus) continue;
+                EXPECT_NEAR(g.fit.surface.radius, 133.65, 1e-6);
+                EXPECT_NEAR(g.fit.surface.minor_radius, 6.35, 1e-6);
+            }
+            if (deflection != 0.9 || angular != 0.35) continue;
+            const auto path = out_dir() / "fanned_fillet.step";
+            auto rev = reverse_to_step(mesh, path, {});
+            ASSERT_TRUE(rev.ok()) << rev.error().describe();
+            EXPECT_TRUE(rev->valid && rev->solid);
+            EXPECT_TRUE(rev->fallbacks.empty());
+            EXPECT_EQ(rev->faces, 4u);
+        }
     }
 }
 

@@ -316,7 +316,10 @@ double chord_sag(const Surface& s, double len, std::span<const Vec3> corners) {
         default:
             return 0;
     }
-    return rho > 0 ? len * len / (8 * rho) : 0;
+    // No middle of a chord of a sphere is farther off than its radius; a "chord" whose middle
+    // is farther off than rho spans the hole of a torus or the inside of a bore (a plane's cap
+    // facet with its corners on the rim its fillet or bore meets), it is not one of s.
+    return rho > 0 ? std::min(len * len / (8 * rho), rho) : 0;
 }
 
 /// Facet f as a chord of s where the deflection estimate is too tight: its corners within the
@@ -783,18 +786,26 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
         auto r =
             fit_faces(c, faces, kinds, std::nullopt, &misses, std::min(na, nb) <= kLooseFacets);
         if (!r && fragments) {
-            // A fragment of one kind joins as it is when its facets are chords of the other's
+            // A fragment joins its neighbour as it is when its facets are chords of the other's
             // surface: the union's fit holds the fans of a coarse fillet, which sag beyond the
-            // deflection estimate (chord_fits()), to that estimate again. Not across kinds: a
-            // torus taking a cone strip's facets (normals agreeing) left the M6 screw a valid
-            // solid 41 % short of its volume.
+            // deflection estimate (chord_fits()), to that estimate again. Across kinds only
+            // when that surface has the fragment's corners no farther than its own does: a
+            // strip of a large fillet grown as a cylinder lies on the fillet's torus to
+            // rounding, while a torus took a cone strip of the M6 screw within the tolerance
+            // only (the B-rep then built a valid solid 41 % short of its volume).
             const auto takes = [&](std::uint32_t from, std::uint32_t to) {
-                if (drafts[from].surface.kind != drafts[to].surface.kind) return false;
-                for (const std::uint32_t f : drafts[from].faces)
-                    if (facet_cost(c, drafts[to].surface, f, false) > c.tol &&
-                        !chord_fits(c, drafts[to].surface, f))
-                        return false;
-                return true;
+                const Surface& st = drafts[to].surface;
+                const Surface& own = drafts[from].surface;
+                double on_own = 0, on_to = 0;
+                for (const std::uint32_t f : drafts[from].faces) {
+                    if (facet_cost(c, st, f, false) > c.tol && !chord_fits(c, st, f)) return false;
+                    for (int i = 0; i < 3; ++i) {
+                        const Vec3 p = c.m.position(c.m.vertex(fid(f), i));
+                        on_own = std::max(on_own, distance(own, p));
+                        on_to = std::max(on_to, distance(st, p));
+                    }
+                }
+                return own.kind == st.kind || on_to <= on_own;
             };
             const std::uint32_t to = takes(b, a) ? a : takes(a, b) ? b : kNone;
             if (to != kNone) {
