@@ -425,7 +425,7 @@ TEST(ReverseSurfaces, RealPartsFaceForFace) {
 // NIST CTC 05's two large fillets (tori of 6.35 mm along long arcs, meshed at 0.9 mm) are
 // BRepMesh fans whose middles sag up to 3.5 x the deflection estimate, every corner on the
 // torus: each facet is a chord of its torus (chord_fits()), not a one-facet plane. 183 faces
-// and 5 fallbacks before; 160 now, for 162 unified and 156 on one surface.
+// and 5 fallbacks before; 157 now, for 162 unified and 156 on one surface.
 TEST(ReverseSurfaces, CoarseFilletFansAreChords) {
     if (corpus_steps().empty()) GTEST_SKIP() << "no corpus at " << corpus_step_dir();
     const char* name = "nist_ctc_05_asme1_rd.stp";
