@@ -99,23 +99,22 @@ std::size_t faces_on_one_surface(const Mesh& mesh, std::span<const SampleFace> f
     const auto cuts = mesh.cuts();
     std::map<std::int64_t, std::size_t> index;  // true face -> dense index
     for (std::size_t f = 0; f < mesh.num_faces(); ++f) index.emplace(cuts[f], 0);
-    std::size_t n = 0;
-    for (auto& [t, i] : index) i = n++;
+    std::vector<std::string> kind;  // by dense index
+    for (auto& [t, i] : index) {
+        i = kind.size();
+        const bool known = t >= 0 && static_cast<std::size_t>(t) < faces.size();
+        kind.push_back(known ? faces[static_cast<std::size_t>(t)].kind : "other");
+    }
+    const std::size_t n = kind.size();
+    std::vector<std::size_t> dense(mesh.num_faces());  // facet -> its true face's index
+    for (std::size_t f = 0; f < mesh.num_faces(); ++f) dense[f] = index[cuts[f]];
     // Each true face's vertices, with normals from its own facets only.
     std::vector<std::map<std::uint32_t, Vec3>> nodes(n);
     for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
         const FaceId ff(static_cast<std::uint32_t>(f));
         const Vec3 an = mesh.face_normal_area2(ff);
-        for (int k = 0; k < 3; ++k) nodes[index[cuts[f]]][mesh.vertex(ff, k).idx()] += an;
+        for (int k = 0; k < 3; ++k) nodes[dense[f]][mesh.vertex(ff, k).idx()] += an;
     }
-    const auto kind_of = [&](std::size_t i) -> std::string {
-        auto it = index.begin();
-        std::advance(it, static_cast<std::ptrdiff_t>(i));
-        const std::int64_t t = it->first;
-        return t >= 0 && static_cast<std::size_t>(t) < faces.size()
-                   ? faces[static_cast<std::size_t>(t)].kind
-                   : std::string("other");
-    };
     const std::map<std::string, FitKind> elementary = {{"plane", FitKind::kPlane},
                                                        {"sphere", FitKind::kSphere},
                                                        {"cylinder", FitKind::kCylinder},
@@ -125,7 +124,7 @@ std::size_t faces_on_one_surface(const Mesh& mesh, std::span<const SampleFace> f
     for (std::size_t h = 0; h < mesh.num_halfedges(); ++h) {
         const HalfedgeId hh(static_cast<std::uint32_t>(h));
         if (mesh.is_boundary(hh)) continue;
-        const std::size_t a = index[cuts[h / 3]], b = index[cuts[mesh.twin(hh).idx() / 3]];
+        const std::size_t a = dense[h / 3], b = dense[mesh.twin(hh).idx() / 3];
         if (a < b) pairs.emplace(a, b);
     }
     std::vector<std::size_t> parent(n);
@@ -137,8 +136,7 @@ std::size_t faces_on_one_surface(const Mesh& mesh, std::span<const SampleFace> f
     std::size_t count = n;
     for (const auto& [a, b] : pairs) {
         if (root(a) == root(b)) continue;
-        const std::string ka = kind_of(a), kb = kind_of(b);
-        const auto ea = elementary.find(ka), eb = elementary.find(kb);
+        const auto ea = elementary.find(kind[a]), eb = elementary.find(kind[b]);
         FitKindSet kinds = kRevolutionFitKinds;
         if (ea != elementary.end() && eb != elementary.end() && ea->second != eb->second) continue;
         if (ea != elementary.end()) kinds = fit_kind_bit(ea->second);
@@ -398,11 +396,11 @@ TEST(ReverseSurfaces, RealPartsFaceForFace) {
     for (const char* name :
          {"mfcad_2-3-3-3-3-23.step", "mfcad_4-5-6-13-19.step", "nist_ctc_03_asme1_rc.stp",
           "nist_ftc_09_asme1_rd.stp", "827-9999-904.stp",
-          // Tori of 0.4 mm fillets round its pockets' corners: 146 faces
-          // until the spine start (fitting.md), 144 now.
+          // Tori of 0.4 mm fillets round its pockets' corners: 146 faces until the spine
+          // start (fitting.md), 144 now.
           "nist_ftc_06_asme1_rd.stp",
-          // Bull-nose tori meshed with BRepMesh fans whose middles sag
-          // 1.3x the chordal deflection: 6 faces, not 86 one-facet planes.
+          // Bull-nose tori meshed with BRepMesh fans whose middles sag 1.3x the chordal
+          // deflection: 6 faces, not 86 one-facet planes.
           "nist_ftc_11_asme1_rb.stp"}) {
         const Outcome o =
             reverse_part(corpus_part(corpus_step_dir() / name), false, ReverseMethod::kAuto, name);

@@ -798,7 +798,7 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
                 const Surface& own = drafts[from].surface;
                 double on_own = 0, on_to = 0;
                 for (const std::uint32_t f : drafts[from].faces) {
-                    if (facet_cost(c, st, f, false) > c.tol && !chord_fits(c, st, f)) return false;
+                    if (!chord_fits(c, st, f)) return false;  // (all facet_cost() takes too)
                     for (int i = 0; i < 3; ++i) {
                         const Vec3 p = c.m.position(c.m.vertex(fid(f), i));
                         on_own = std::max(on_own, distance(own, p));
