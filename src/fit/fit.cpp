@@ -318,12 +318,15 @@ struct ConeModel {
     static constexpr int N = 6;
     Axis a;
     double r, alpha;
+    double ca, sa;  ///< cos and sin of alpha, once per model rather than once per point
+    static ConeModel make(const Axis& a, double r, double alpha) {
+        return {a, r, alpha, std::cos(alpha), std::sin(alpha)};
+    }
     double residual(Vec3 p, double* J) const {
         const Vec3 q = p - a.c;
         const double h = dot(q, a.d);
         const Vec3 radial = q - h * a.d;
         const double rho = norm(radial);
-        const double ca = std::cos(alpha), sa = std::sin(alpha);
         if (J) {
             const Vec3 e = rho > 0 ? radial / rho : a.u;
             const double eu = dot(e, a.u), ev = dot(e, a.v);
@@ -337,7 +340,7 @@ struct ConeModel {
         return (rho - r) * ca - h * sa;
     }
     ConeModel stepped(const double* d) const {
-        return {a.stepped(d[0], d[1], d[2], d[3]), r + d[4], alpha + d[5]};
+        return make(a.stepped(d[0], d[1], d[2], d[3]), r + d[4], alpha + d[5]);
     }
     bool runaway(double extent) const { return std::fabs(r) > kRunaway * extent; }
     Surface surface() const {
@@ -987,11 +990,10 @@ FitResult cone_about(const FitInput& in, Vec3 c, Vec3 d) {
         d = -d;  // the radius grows along the axis direction
         t = -t;
     }
-    ConeModel m{Axis::make(c, d), r, std::atan(t)};
+    ConeModel m = ConeModel::make(Axis::make(c, d), r, std::atan(t));
     const int it = refine(m, in);
     if (m.alpha < 0) {  // crossed through a cylinder: turn the axis round
-        m.a = Axis::make(m.a.c, -m.a.d);
-        m.alpha = -m.alpha;
+        m = ConeModel::make(Axis::make(m.a.c, -m.a.d), m.r, -m.alpha);
     }
     FitResult res = finish(m, it, in);
     if (res.ok && !(m.alpha > 0 && m.alpha < 0.5 * std::numbers::pi)) {
@@ -2287,7 +2289,7 @@ FitResult refit_surface(const Surface& s, unsigned frozen, const FitInput& in) {
         case FitKind::kCylinder:
             return refit(CylinderModel{Axis::make(s.point, s.axis), s.radius}, frozen, in);
         case FitKind::kCone:
-            return refit(ConeModel{Axis::make(s.point, s.axis), s.radius, s.angle}, frozen, in);
+            return refit(ConeModel::make(Axis::make(s.point, s.axis), s.radius, s.angle), frozen, in);
         case FitKind::kTorus:
             return refit(TorusModel{Axis::make(s.point, s.axis), s.radius, s.minor_radius}, frozen,
                          in);
