@@ -215,6 +215,36 @@ std::vector<std::array<double, 3>> untriangulated_faces(const TopoDS_Shape& shap
     return out;
 }
 
+std::vector<double> faces_from_mesh(std::span<const TopoDS_Face> faces, const Mesh& mesh,
+                                    double deflection) {
+    std::vector<Triangle> mesh_tris(mesh.num_faces());
+    for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
+        for (int i = 0; i < 3; ++i) mesh_tris[f][i] = mesh.position(mesh.vertex(FaceId(f), i));
+    }
+    const TriangleTree tree(std::move(mesh_tris));
+    // Faces share their edges' polygons: those without triangles are meshed one at a time.
+    for (const TopoDS_Face& face : faces) {
+        TopLoc_Location loc;
+        if (BRep_Tool::Triangulation(face, loc).IsNull()) {
+            BRepMesh_IncrementalMesh(face, deflection, false, 0.2, false);
+        }
+    }
+    std::vector<double> out(faces.size(), -1.0);
+    tbb::parallel_for(std::size_t{0}, faces.size(), [&](std::size_t k) {
+        TopLoc_Location loc;
+        const Handle(Poly_Triangulation) tri = BRep_Tool::Triangulation(faces[k], loc);
+        if (tri.IsNull()) return;
+        const gp_Trsf tr = loc.Transformation();
+        double far = 0;
+        for (int i = 1; i <= tri->NbNodes(); ++i) {
+            const gp_Pnt p = tri->Node(i).Transformed(tr);
+            far = std::max(far, tree.distance(Vec3{p.X(), p.Y(), p.Z()}));
+        }
+        out[k] = far;
+    });
+    return out;
+}
+
 SolidDeviation measure_deviation(const TopoDS_Shape& shape, const Mesh& mesh, double deflection) {
     SolidDeviation out;
     out.deflection = deflection;

@@ -1,8 +1,10 @@
 // How far a B-rep is from the mesh it was built from, both ways. Internal.
 #pragma once
 
+#include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
 #include <array>
+#include <span>
 #include <vector>
 
 #include "ncrev/brep.h"
@@ -23,6 +25,12 @@ SolidDeviation measure_deviation(const TopoDS_Shape& shape, const Mesh& mesh, do
 /// and the deviation would not see it.
 std::vector<std::array<double, 3>> untriangulated_faces(const TopoDS_Shape& shape,
                                                         double deflection);
+
+/// For each of `faces`, the largest distance from a node of its triangulation (BRepMesh at
+/// `deflection`, made where the face has none) to `mesh`; -1 for a face BRepMesh leaves
+/// without triangles. Deterministic whatever the thread count.
+std::vector<double> faces_from_mesh(std::span<const TopoDS_Face> faces, const Mesh& mesh,
+                                    double deflection);
 
 /// The point of triangle abc closest to p.
 Vec3 closest_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c);

@@ -101,4 +101,27 @@ SurfaceBrep build_surface_brep(const Mesh& mesh, const FaceMap<std::int32_t>& re
                                std::span<const RegionSurface> regions,
                                const SurfaceBrepOptions& options);
 
+/// How far a solid's volume may be from its mesh's, in units of the volume the mesh's own
+/// error spans: the area of its facets on curved surfaces times its chordal deflection (their
+/// vertices lie on the part's surface and the facets within the deflection of it), plus its
+/// whole area times the tolerance (every face lies within it of its facets' vertices: a plane
+/// fitted to them too). Twice that, since the deflection is an estimate and BRepMesh's fans on
+/// a coarse fillet sag up to 3.5 times it (docs/segmentation.md, step 6) — over their own area,
+/// a share of the curved area.
+constexpr double kVolumeSlack = 2;
+
+/// Whether a solid of `solid_volume` can be the part a closed mesh of `mesh_volume` came from
+/// (kVolumeSlack), the mesh having `area` in all, `curved_area` of it on curved surfaces, with
+/// that chordal deflection and segmentation tolerance. A valid solid can fail this: a face
+/// built over the wrong piece of its surface.
+bool volume_is_the_parts(double solid_volume, double mesh_volume, double area, double curved_area,
+                         double chordal_deflection, double tolerance);
+
+/// The region of `brep` built with its exact faces (not a fallback, not absorbed, and with
+/// `facets_only[r]` empty) whose faces lie farthest from `mesh` (faces_from_mesh() at
+/// `deflection`): where a solid of the wrong volume was built wrong — its neighbours, trimmed
+/// by the wrong face, still lie on the mesh. -1 when there is none.
+std::int32_t farthest_region(const Mesh& mesh, const SurfaceBrep& brep,
+                             const std::vector<std::string>& facets_only, double deflection);
+
 }  // namespace ncrev::brep_detail
