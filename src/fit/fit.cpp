@@ -2289,7 +2289,8 @@ FitResult refit_surface(const Surface& s, unsigned frozen, const FitInput& in) {
         case FitKind::kCylinder:
             return refit(CylinderModel{Axis::make(s.point, s.axis), s.radius}, frozen, in);
         case FitKind::kCone:
-            return refit(ConeModel::make(Axis::make(s.point, s.axis), s.radius, s.angle), frozen, in);
+            return refit(ConeModel::make(Axis::make(s.point, s.axis), s.radius, s.angle), frozen,
+                         in);
         case FitKind::kTorus:
             return refit(TorusModel{Axis::make(s.point, s.axis), s.radius, s.minor_radius}, frozen,
                          in);
