@@ -73,9 +73,12 @@ double knot(int i, int p, int n) {
 /// (dN may be null). P > 0 fixes the degree at compile time (p is then P): the cubic
 /// profiles' projections call this tens of millions of times, and with the loops unrolled it
 /// costs about half. The same operations in the same order either way.
+/// `knots`, when given, holds knot(i, p, n) for i in [0, n + p] (the same values, looked up).
 template <int P>
-inline int basis_of_degree(int p, int n, double u, double* N, double* dN) {
+inline int basis_of_degree(int p, int n, double u, double* N, double* dN,
+                           const double* knots = nullptr) {
     if constexpr (P > 0) p = P;
+    const auto knot_at = [&](int i) { return knots ? knots[i] : knot(i, p, n); };
     u = std::clamp(u, 0.0, 1.0);
     const int span = std::min(n - 1, p + static_cast<int>(std::floor(u * (n - p))));
     // Triangular table of A2.2, with derivatives (A2.3, first order).
@@ -83,8 +86,8 @@ inline int basis_of_degree(int p, int n, double u, double* N, double* dN) {
     double left[kMaxDegree + 1], right[kMaxDegree + 1];
     ndu[0][0] = 1.0;
     for (int j = 1; j <= p; ++j) {
-        left[j] = u - knot(span + 1 - j, p, n);
-        right[j] = knot(span + j, p, n) - u;
+        left[j] = u - knot_at(span + 1 - j);
+        right[j] = knot_at(span + j) - u;
         double saved = 0.0;
         for (int r = 0; r < j; ++r) {
             ndu[j][r] = right[r + 1] + left[j - r];
@@ -110,9 +113,17 @@ int basis(int p, int n, double u, double* N, double* dN) {
     return p == 3 ? basis_of_degree<3>(p, n, u, N, dN) : basis_of_degree<0>(p, n, u, N, dN);
 }
 
-/// basis() of degree 3.
-int cubic_basis(int n, double u, double* N, double* dN) {
-    return basis_of_degree<3>(3, n, u, N, dN);
+/// basis() of degree 3, with the knots from cubic_knots(n) when given.
+int cubic_basis(int n, double u, double* N, double* dN, const double* knots = nullptr) {
+    return basis_of_degree<3>(3, n, u, N, dN, knots);
+}
+
+/// knot(i, 3, n) for i in [0, n + 3]: a profile's projections divide for them otherwise at
+/// every evaluation.
+std::vector<double> cubic_knots(int n) {
+    std::vector<double> k(static_cast<std::size_t>(n + 4));
+    for (int i = 0; i <= n + 3; ++i) k[static_cast<std::size_t>(i)] = knot(i, 3, n);
+    return k;
 }
 
 }  // namespace
@@ -1758,10 +1769,11 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
         // The distance of each point from the curve in the plane across (its distance from
         // the extrusion: every point lies within the extrusion's span), from its projection.
         std::vector<double> off(n, 0.0);
+        const std::vector<double> knots = cubic_knots(np);
         // The profile's point at u and its derivative there.
         const auto curve = [&](double u, double& cx, double& cy, double& dx, double& dy) {
             double N[kMaxDegree + 1], dN[kMaxDegree + 1];
-            const int sp = cubic_basis(np, u, N, dN) - 3;
+            const int sp = cubic_basis(np, u, N, dN, knots.data()) - 3;
             cx = cy = dx = dy = 0;
             for (int a = 0; a <= 3; ++a) {
                 cx += N[a] * px(sp + a), cy += N[a] * py(sp + a);
@@ -1799,7 +1811,7 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
             Eigen::VectorXd bx = Eigen::VectorXd::Zero(np), by = Eigen::VectorXd::Zero(np);
             for (std::size_t i = 0; i < all; ++i) {
                 double N[kMaxDegree + 1];
-                const int sp = cubic_basis(np, s[i], N, nullptr) - 3;
+                const int sp = cubic_basis(np, s[i], N, nullptr, knots.data()) - 3;
                 const double w = w_of(i);
                 for (int a = 0; a <= 3; ++a) {
                     bx(sp + a) += w * N[a] * xs[i];
