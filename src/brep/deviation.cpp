@@ -170,6 +170,14 @@ class TriangleTree {
     std::vector<Node> nodes_;
 };
 
+std::vector<Triangle> mesh_triangles(const Mesh& mesh) {
+    std::vector<Triangle> tris(mesh.num_faces());
+    for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
+        for (int i = 0; i < 3; ++i) tris[f][i] = mesh.position(mesh.vertex(FaceId(f), i));
+    }
+    return tris;
+}
+
 DistanceStats stats_of(const std::vector<Vec3>& points, const TriangleTree& tree) {
     std::vector<double> d(points.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024),
@@ -217,11 +225,7 @@ std::vector<std::array<double, 3>> untriangulated_faces(const TopoDS_Shape& shap
 
 std::vector<double> faces_from_mesh(std::span<const TopoDS_Face> faces, const Mesh& mesh,
                                     double deflection) {
-    std::vector<Triangle> mesh_tris(mesh.num_faces());
-    for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
-        for (int i = 0; i < 3; ++i) mesh_tris[f][i] = mesh.position(mesh.vertex(FaceId(f), i));
-    }
-    const TriangleTree tree(std::move(mesh_tris));
+    const TriangleTree tree(mesh_triangles(mesh));
     // Faces share their edges' polygons: those without triangles are meshed one at a time.
     for (const TopoDS_Face& face : faces) {
         TopLoc_Location loc;
@@ -272,13 +276,9 @@ SolidDeviation measure_deviation(const TopoDS_Shape& shape, const Mesh& mesh, do
             solid_tris.push_back({node(a), node(b), node(c)});
         }
     }
-    std::vector<Triangle> mesh_tris(mesh.num_faces());
-    for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
-        for (int i = 0; i < 3; ++i) mesh_tris[f][i] = mesh.position(mesh.vertex(FaceId(f), i));
-    }
     std::vector<Vec3> mesh_points(mesh.positions().begin(), mesh.positions().end());
     out.mesh_to_solid = stats_of(mesh_points, TriangleTree(std::move(solid_tris)));
-    out.solid_to_mesh = stats_of(solid_nodes, TriangleTree(std::move(mesh_tris)));
+    out.solid_to_mesh = stats_of(solid_nodes, TriangleTree(mesh_triangles(mesh)));
     return out;
 }
 
