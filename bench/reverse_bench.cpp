@@ -8,6 +8,7 @@
 
 #include "bench_common.h"
 #include "ncrev/brep.h"
+#include "ncrev/io.h"
 #include "ncrev/mesh.h"
 #include "ncrev/sample.h"
 
@@ -124,19 +125,14 @@ const SurfacesCase& surfaces_case(int which) {
         made = make_sample_part(c.name, so);
     }
     if (made) {
-        c.soup = made->mesh;
+        // What an STL carries, as the library writes and reads one: triangles only, their
+        // corners in float32 (the rounding decides things: the featuretype case in doubles was
+        // segmented once where its STL was segmented twice, docs/benchmarks.md, fifteenth
+        // session).
+        const auto bytes = encode_stl_binary(made->mesh.points, made->mesh.triangles);
+        if (auto read = read_stl(bytes)) c.soup = std::move(read).value();
         c.true_faces = made->faces.size();
     }
-    // What an STL carries: triangles only, their corners in float32 (the rounding decides
-    // things: the featuretype case in doubles segmented once where its STL was segmented twice,
-    // docs/benchmarks.md, fifteenth session).
-    for (Vec3& p : c.soup.points)
-        for (int i = 0; i < 3; ++i) p[i] = static_cast<double>(static_cast<float>(p[i]));
-    c.soup.color.clear();
-    c.soup.cut.clear();
-    c.soup.surface.clear();
-    c.soup.surfaces.clear();
-    c.soup.tools.clear();
     return cache.emplace(which, std::move(c)).first->second;
 }
 

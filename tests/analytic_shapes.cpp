@@ -252,8 +252,8 @@ AnalyticMesh inside_out(AnalyticMesh m) {
     return m;
 }
 
-void round_to_float(Indexed& m) {
-    for (Vec3& p : m.points)
+void round_to_float(std::span<Vec3> points) {
+    for (Vec3& p : points)
         for (int i = 0; i < 3; ++i) p[i] = static_cast<double>(static_cast<float>(p[i]));
 }
 

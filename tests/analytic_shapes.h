@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -49,7 +50,7 @@ AnalyticMesh iso_saddle(double a, double extent, const IsoOptions& o);
 AnalyticMesh inside_out(AnalyticMesh m);
 
 /// Rounds every coordinate to float32, as a binary STL stores it.
-void round_to_float(Indexed& m);
+void round_to_float(std::span<Vec3> points);
 /// Moves every vertex by a Gaussian of standard deviation sigma in each coordinate.
 void add_noise(Indexed& m, double sigma, std::uint64_t seed);
 

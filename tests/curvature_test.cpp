@@ -285,7 +285,7 @@ TEST(Curvature, Float32RoundingAndSmallNoise) {
     auto interior = a.interior;
     a.curvature = [curvature](Vec3 q) { return curvature(q - Vec3{100, 200, 0}); };
     a.interior = [interior](Vec3 q) { return interior(q - Vec3{100, 200, 0}); };
-    test::round_to_float(a.mesh);
+    test::round_to_float(a.mesh.points);
     const Errors rounded = measure(a, {});
     EXPECT_LE(rounded.mean(), 0.005);
     EXPECT_LE(rounded.p95(), 0.02);

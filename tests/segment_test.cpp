@@ -579,8 +579,7 @@ TEST(Segment, SplineWallOfACorpusPartIsFreeForm) {
         SamplePart& part = made.value();
         // Its points as an STL stores them (float32), as `ncrev reverse` of the benchmark's
         // case reads them.
-        for (Vec3& p : part.mesh.points)
-            for (int i = 0; i < 3; ++i) p[i] = static_cast<double>(static_cast<float>(p[i]));
+        test::round_to_float(part.mesh.points);
         const Mesh mesh = build_mesh(part.mesh).value().mesh;
         const SegmentResult r = segment(mesh).value();
         EXPECT_EQ(r.tolerance_rule.find("noise"), std::string::npos) << r.tolerance_rule;

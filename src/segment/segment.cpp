@@ -115,8 +115,8 @@ constexpr double kStrayShare = 0.1;
 /// long strips (NIST FTC 07: 0.2 %), not the rim rows of two small regions of like facets
 /// (CTC 03's cone and cylinder at 3-4 %, which stay apart).
 constexpr double kOrphanShare = 0.01;
-/// A small neighbour whose vertices lie this many tolerances from a dominant region's surface,
-/// a surface fitted to at least kMaxGrowthRefit facets, cannot join it (see merge_regions()):
+/// A small neighbour whose vertices lie this many tolerances from the surface of a dominant
+/// region of at least kMaxGrowthRefit facets cannot join it (see merge_regions()):
 /// the union's surface fits the dominant region's vertices within the tolerance as its own
 /// does, so the two are within 2 tolerances of each other there, and by little more a facet
 /// beside them; the rest is margin.
@@ -734,9 +734,6 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
     std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
     for (const auto& [a, b] : pairs) nbrs[a].push_back(b), nbrs[b].push_back(a);
     std::vector<std::uint32_t> version(drafts.size(), 0);
-    // The facets each region's surface was last fitted to (as grown: all of them, near enough).
-    std::vector<std::size_t> fitted(drafts.size());
-    for (std::size_t d = 0; d < drafts.size(); ++d) fitted[d] = drafts[d].faces.size();
     // (cost, a, b, their versions, whether the cost is exact or a lower bound).
     using Item =
         std::tuple<double, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t, bool>;
@@ -794,8 +791,8 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
         groups.clear();
         const bool loose = std::min(na, nb) <= kLooseFacets;
         std::optional<FitResult> r;
-        // A dominant region whose surface was fitted to kMaxGrowthRefit facets or more (known
-        // far better than the tolerance: growing refits no larger region) and a small
+        // A dominant region of kMaxGrowthRefit facets or more (its surface known far better
+        // than the tolerance: growing refits no larger region) and a small
         // neighbour: refitting the union costs the large region's every point (a fillet of 72k
         // facets met 138 one- and two-facet neighbours on the fillet block meshed to 345k
         // facets, and the pairs it refused came back each time it grew). The union's surface,
@@ -807,7 +804,7 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
         // neighbour strips move by more than 10 tolerances, 640 -> 708 faces.)
         const std::uint32_t big = na >= nb ? a : b, small = big == a ? b : a;
         if (!fragments && drafts[big].faces.size() >= kDominantRatio * drafts[small].faces.size() &&
-            fitted[big] >= kMaxGrowthRefit) {
+            drafts[big].faces.size() >= kMaxGrowthRefit) {
             const Surface& sb = drafts[big].surface;
             double far_area = 0, small_area = 0;
             bool on = true;
@@ -826,7 +823,6 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
                 r->surface = sb;
             }
         }
-        const bool unfitted = r.has_value();
         if (!r) r = fit_faces(c, faces, kinds, std::nullopt, &misses, loose);
         if (!r && fragments) {
             // A fragment joins its neighbour as it is when its facets are chords of the other's
@@ -938,14 +934,12 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
                 std::erase(faces, f);
                 region[f] = id;
             }
-            fitted.push_back(d.faces.size());
             drafts.push_back(std::move(d));
             version.push_back(0);
             nbrs.emplace_back();
             born.push_back(id);
         }
         std::sort(faces.begin(), faces.end());
-        if (!unfitted) fitted[keep] = faces.size();
         drafts[keep].faces = std::move(faces);
         drafts[keep].surface = r->surface;
         drafts[gone].alive = false;
