@@ -229,6 +229,9 @@ struct Context {
     double sag = 0;  ///< the mesh's chordal deflection, estimated (estimate_sag())
     std::vector<std::uint8_t> sharp_edge;  ///< per half-edge
     std::vector<float> edge_turn;          ///< |dihedral angle| per half-edge (0 on a border)
+    /// Per facet: the largest sag estimate of its smooth curved edges (estimate_sag()), 0 where
+    /// none turns: how far its middle may sag as a ruled surface's chord (chords_agree()).
+    std::vector<float> facet_sag;
     tbb::enumerable_thread_specific<Gatherer> gatherers;
     explicit Context(const Mesh& mesh)
         : m(mesh), gatherers([&mesh] { return Gatherer(mesh.num_vertices()); }) {}
@@ -238,9 +241,10 @@ struct Context {
 /// across an edge between facets of heights h1, h2 over it, chords of width h = min(h1, h2)
 /// sag by about 2 h beta / 8 (a circle's chords of step beta and length h sag h beta / 8). The
 /// smaller height: a plane's large facet next to a tangent fillet is no chord of the fillet.
-/// kSagFactor x the kSagQuantile quantile, never below the tolerance.
-double estimate_sag(const Context& c) {
+/// kSagFactor x the kSagQuantile quantile, never below the tolerance. Fills c.facet_sag.
+double estimate_sag(Context& c) {
     const Mesh& m = c.m;
+    c.facet_sag.assign(m.num_faces(), 0.0f);
     std::vector<double> sags;
     for (std::uint32_t h = 0; h < m.num_halfedges(); ++h) {
         const HalfedgeId he(h);
@@ -254,6 +258,10 @@ double estimate_sag(const Context& c) {
         const double h1 = 2 * c.fd.area[Mesh::face(he).idx()] / len;
         const double h2 = 2 * c.fd.area[Mesh::face(t).idx()] / len;
         sags.push_back(2 * std::min(h1, h2) * beta / 8);
+        for (const HalfedgeId x : {he, t}) {
+            float& fs = c.facet_sag[Mesh::face(x).idx()];
+            fs = std::max(fs, static_cast<float>(sags.back()));
+        }
     }
     if (sags.empty()) return c.tol;
     auto q =
@@ -362,20 +370,35 @@ bool sharp_inside(const Context& c, std::span<const std::uint32_t> faces) {
     return false;
 }
 
+/// How far a cylinder's or cone's chords may sag (chords_agree()).
+enum class RuledSag {
+    kDeflection,  ///< the deflection, as any surface's
+    kTwice,       ///< kMiddleSagFactor x the deflection: merging a region of kLooseFacets
+    kOwnEdges,    ///< that, and no more than kSagFactor x the facet's edges' estimate: growing
+};
+
 /// The facets are chords of s: every middle within the sag, and the normals close to s's,
 /// except on at most kNormalOutlierArea of the area (slivers: a thin triangle whose corners lie
 /// on one circle of a torus has that circle's plane, whatever the torus's normal there).
 /// A B-spline is itself held only to the sag at the vertices: its chords' middles get twice.
-/// So do a cylinder's and a cone's with `relax_ruled` (merging a region of at most
-/// kLooseFacets facets) where no sharp edge runs between the facets: facets from rim to rim of
-/// a wide drafted wall (NIST CTC 02's cones of radius 101 at 3 degrees) have generators for
-/// edges, which show no sag, and their middles sag 1.6 x the estimate from the curved edges;
-/// each came back a plane of its own (180 of them on four cones). Not across a sharp edge: the
-/// sides of a prism lie on its circumscribed cylinder within that. Not for larger regions: a
-/// plane of several facets beside a small fillet went into a cone with it (NIST FTC 06, CTC 01).
+/// So may a cylinder's and a cone's with `ruled_sag` (RuledSag) where no sharp edge runs between
+/// the facets: facets from rim to rim of a wide drafted wall (NIST CTC 02's cones of radius 101
+/// at 3 degrees) have generators for edges, which show no sag, and their middles sag 1.6 x the
+/// estimate from the part's curved edges, mostly small fillets held by the angular deflection.
+/// Merging a region of at most kLooseFacets facets with a cylinder or cone, twice the estimate
+/// (180 one-facet planes on four cones came back 102). A growing region taking its next ring
+/// (the other 102), no more than twice its facets' own edges' estimate (Context::facet_sag)
+/// either: a flat strip tangent to a small bore (a plane of two facets, its edges turning by
+/// nothing) lies within the tolerance of a cone or a wide cylinder through both, and NIST CTC
+/// 01, 03 and FTC 06 lost faces to them when every middle in a ring could sag twice the estimate;
+/// not for a plane of more than kLooseFacets facets, which would take a fillet with it
+/// (trimesh_featuretype meshed at 0.02 rad: a plane of 70 facets became a cone of radius 0.37 at
+/// 0.3 tolerances RMS, and the free-form wall beside it lost its face). Not across a sharp edge:
+/// the sides of a prism lie on their circumscribed cylinder within that.
 bool chords_agree(const Context& c, const Surface& s, std::span<const std::uint32_t> faces,
-                  bool relax_ruled = false) {
-    const bool ruled = relax_ruled && (s.kind == FitKind::kCylinder || s.kind == FitKind::kCone);
+                  RuledSag ruled_sag = RuledSag::kDeflection) {
+    const bool ruled = ruled_sag != RuledSag::kDeflection &&
+                       (s.kind == FitKind::kCylinder || s.kind == FitKind::kCone);
     const double limit = s.kind == FitKind::kBSpline ? 2 * c.sag : c.sag;
     double total = 0, outliers = 0;
     bool beyond = false;  // a middle beyond the sag, within twice (a ruled surface)
@@ -383,6 +406,7 @@ bool chords_agree(const Context& c, const Surface& s, std::span<const std::uint3
         const double d = distance(s, c.fd.centroid[f]);
         if (d > limit) {
             if (!ruled || d > kMiddleSagFactor * c.sag) return false;
+            if (ruled_sag == RuledSag::kOwnEdges && d > kSagFactor * c.facet_sag[f]) return false;
             beyond = true;
         }
         total += c.fd.area[f];
@@ -400,7 +424,7 @@ std::optional<FitResult> fit_faces(Context& c, std::span<const std::uint32_t> fa
                                    FitKindSet kinds = kRevolutionFitKinds,
                                    std::optional<FitKind> first = std::nullopt,
                                    std::vector<Surface>* misses = nullptr,
-                                   bool relax_ruled = false) {
+                                   RuledSag ruled_sag = RuledSag::kDeflection) {
     PointSet ps;
     c.gatherers.local().gather(c.m, c.fd, faces, ps);
     // `first` (the kind a growing region has) is tried before the others: refitting a torus of
@@ -418,7 +442,7 @@ std::optional<FitResult> fit_faces(Context& c, std::span<const std::uint32_t> fa
         if (ps.points.size() < kMinVertices[static_cast<int>(kind)]) continue;
         FitResult r = fit(kind, in);
         if (!r.ok) continue;
-        if (r.max <= c.tol && chords_agree(c, r.surface, faces, relax_ruled)) return r;
+        if (r.max <= c.tol && chords_agree(c, r.surface, faces, ruled_sag)) return r;
         if (misses) misses->push_back(r.surface);
     }
     return std::nullopt;
@@ -588,7 +612,16 @@ std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patc
             // fine torus grows as a cylinder until the torus leaves it by the tolerance).
             const FitKindSet kinds =
                 firm_plane(c, d) ? fit_kind_bit(d.surface.kind) : kRevolutionFitKinds;
-            auto r = fit_faces(c, trial, kinds, settled(d));
+            // As growing takes a facet (facet_fits()), a cylinder's or cone's chords may sag
+            // more than the deflection where the facets' own edges say so (chords_agree()).
+            const RuledSag ruled_sag =
+                d.surface.kind != FitKind::kPlane || d.faces.size() <= kLooseFacets
+                    ? RuledSag::kOwnEdges
+                    : RuledSag::kDeflection;
+            const auto ring_fit = [&](std::span<const std::uint32_t> t) {
+                return fit_faces(c, t, kinds, settled(d), nullptr, ruled_sag);
+            };
+            auto r = ring_fit(trial);
             if (!r) {
                 // The second ring: unassigned neighbours of the first, not yet queued.
                 const std::size_t first = trial.size();
@@ -599,7 +632,7 @@ std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patc
                         trial.push_back(g);
                     }
                 }
-                if (trial.size() > first) r = fit_faces(c, trial, kinds, settled(d));
+                if (trial.size() > first) r = ring_fit(trial);
                 if (r) {
                     rejected.assign(trial.begin() + static_cast<std::ptrdiff_t>(d.faces.size()),
                                     trial.end());
@@ -789,7 +822,8 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
         misses.clear();
         homes.clear();
         groups.clear();
-        const bool loose = std::min(na, nb) <= kLooseFacets;
+        const RuledSag ruled_sag =
+            std::min(na, nb) <= kLooseFacets ? RuledSag::kTwice : RuledSag::kDeflection;
         std::optional<FitResult> r;
         // A dominant region of kMaxGrowthRefit facets or more (its surface known far better
         // than the tolerance: growing refits no larger region) and a small
@@ -817,13 +851,13 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
                 on = on && worst <= c.tol;
             }
             if (2 * far_area >= small_area && small_area > 0) continue;
-            if (on && chords_agree(c, sb, drafts[small].faces, loose)) {
+            if (on && chords_agree(c, sb, drafts[small].faces, ruled_sag)) {
                 r.emplace();
                 r->ok = true;
                 r->surface = sb;
             }
         }
-        if (!r) r = fit_faces(c, faces, kinds, std::nullopt, &misses, loose);
+        if (!r) r = fit_faces(c, faces, kinds, std::nullopt, &misses, ruled_sag);
         if (!r && fragments) {
             // A fragment joins its neighbour as it is when its facets are chords of the other's
             // surface: the union's fit holds the fans of a coarse fillet, which sag beyond the
