@@ -192,6 +192,8 @@ TEST(CliReverse, AutoGivesTheTrueFacesWithLabelsSegmentsAndReport) {
     EXPECT_GT(rev["deviation"]["mesh_to_solid"]["points"].get<int>(), 0);
     EXPECT_LT(rev["deviation"]["mesh_to_solid"]["max"].get<double>(),
               2 * rev["segment"]["chordal_deflection"].get<double>());
+    ASSERT_FALSE(rev["segment"]["steps"].empty());  // the segmentation's steps, timed
+    EXPECT_EQ(rev["segment"]["steps"][0]["name"], "edges");
     std::ifstream in(labels);
     std::set<int> ids;
     std::size_t lines = 0;
@@ -330,6 +332,9 @@ TEST(CliSegment, WritesRegionsLabelsAndOneJsonDocument) {
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["segment"]["method"], "facets");
     EXPECT_GT(j["segment"]["tolerance"].get<double>(), 0.0);
+    ASSERT_EQ(j["segment"]["steps"].size(), 6u);  // edges, grow, merge, freeform, refine, fit
+    EXPECT_EQ(j["segment"]["steps"][1]["name"], "grow");
+    EXPECT_GE(j["segment"]["steps"][1]["seconds"].get<double>(), 0.0);
     const auto& regions = j["regions"];
     ASSERT_EQ(regions.size(), 15u);  // the slot plate's faces
     std::uint64_t facets = 0;

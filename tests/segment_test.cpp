@@ -218,6 +218,17 @@ TEST(Segment, RegionsCarryTheirSurfaces) {
     std::map<std::string, int> want;
     for (const SampleFace& f : c.part.faces) ++want[truth_kind(f.kind)];
     EXPECT_EQ(kinds, want);
+    // Each step's seconds, in order (one pass: the mesh is clean), within the whole.
+    std::vector<std::string> steps;
+    double sum = 0;
+    for (const auto& [name, seconds] : r.step_seconds) {
+        steps.push_back(name);
+        EXPECT_GE(seconds, 0) << name;
+        sum += seconds;
+    }
+    EXPECT_EQ(steps,
+              (std::vector<std::string>{"edges", "grow", "merge", "freeform", "refine", "fit"}));
+    EXPECT_LE(sum, 1.001 * (r.curvature_seconds + r.segment_seconds + r.fit_seconds) + 1e-6);
 }
 
 TEST(Segment, LabelsFollowTheInputFacets) {
@@ -253,6 +264,10 @@ TEST(Segment, NoisyMeshesAreSegmentedAtTheirNoise) {
         const SegmentResult r = segment(c.mesh).value();
         EXPECT_NE(r.tolerance_rule.find("noise"), std::string::npos) << r.tolerance_rule;
         EXPECT_GT(r.tolerance, 0.06);  // about 6 x 0.02, against 0.025 from the size
+        // The passes before the last are one step, first.
+        ASSERT_FALSE(r.step_seconds.empty());
+        EXPECT_EQ(r.step_seconds.front().first, "earlier passes");
+        EXPECT_GT(r.step_seconds.front().second, 0);
         const Score s = score(c.mesh, r, c.part);
         EXPECT_GE(s.iou, 0.98) << name << ": " << s.worst;
         EXPECT_GE(s.kind_right, 0.98) << name;

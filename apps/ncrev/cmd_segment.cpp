@@ -59,10 +59,12 @@ void add_segment(CLI::App& app, Context& ctx) {
         ->check(CLI::Range(1.0, 179.0));
     cmd->add_flag("--no-surface-indices", o->no_surfaces,
                   "Segment every facet, ignoring the surface indices of an SRE file");
-    cmd->add_flag("--json", o->json,
-                  "Print one JSON object on stdout: input, healing, mesh, segment (method, "
-                  "tolerances, counts, seconds) and regions (id, kind, params, facets, area, "
-                  "rms, max)");
+    cmd->add_flag(
+        "--json", o->json,
+        "Print one JSON object on stdout: input, healing, mesh, segment (method, "
+        "tolerances, counts, seconds, each step's seconds) and regions (id, kind, params, "
+        "facets, area, "
+        "rms, max)");
     cmd->add_flag("-q,--quiet", o->quiet, "No warnings and no progress on stderr");
     cmd->callback([o, &ctx]() {
         const std::filesystem::path in(o->input), out(o->output);

@@ -51,7 +51,9 @@ std::string to_json(const InfoReport& report, int indent = 2);
 
 /// The report of `ncrev reverse`: the info keys plus "reverse" (method, stages with seconds,
 /// faces by surface kind, faces, edges, vertices, solid, valid, volumes and areas of the mesh
-/// and of the solid, STEP bytes); warnings of both.
+/// and of the solid, STEP bytes; for the surface methods also "segment": method, tolerance and
+/// its rule, chordal deflection, given facets and "steps" as `ncrev segment` reports them);
+/// warnings of both.
 std::string to_json(const InfoReport& info, const ReverseReport& reverse, int indent = 2);
 
 /// The report of `ncrev curvature`: the info keys plus "curvature" (estimator, neighbourhood,
@@ -63,7 +65,8 @@ std::string to_json(const InfoReport& info, const CurvatureResult& curvature, do
 std::string to_text(const CurvatureResult& curvature, Unit unit);
 
 /// The report of `ncrev segment`: the info keys plus "segment" (method, tolerance, chordal
-/// deflection and sharp angle with their rules, counts, seconds per stage, regions by kind) and
+/// deflection and sharp angle with their rules, counts, seconds per stage, "steps": [{"name",
+/// "seconds"}...] as SegmentResult::step_seconds, regions by kind) and
 /// "regions": one object per region, {"id", "kind", "params", "facets", "area", "rms", "max",
 /// "within_tolerance", "surface_index"}; params by kind: plane point, normal; cylinder
 /// axis_point, axis_dir, radius; cone apex, axis_dir (the radius grows along it), half_angle

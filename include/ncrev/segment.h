@@ -101,6 +101,12 @@ struct SegmentResult {
     std::uint64_t freeform_groups = 0;    ///< groups of pieces replaced by one B-spline
     std::uint64_t reassigned_facets = 0;  ///< border facets moved to a better-fitting region
     double curvature_seconds = 0, segment_seconds = 0, fit_seconds = 0;
+    /// Wall-clock seconds of each step, in order: "edges" (dihedral angles, sharp edges, the
+    /// deflection estimate), "grow" (the facets method's regions; "curvature" for the paper's),
+    /// "merge", "freeform", "refine" (corner surfaces, small regions, borders, fragments; the
+    /// facets method) and "fit". When the noise rule segmented again, these are the last pass's,
+    /// after an "earlier passes" entry for the ones before.
+    std::vector<std::pair<std::string, double>> step_seconds;
 };
 
 /// Segments `mesh`. Never throws; deterministic whatever the thread count. Fails (kBadValue)

@@ -94,6 +94,14 @@ Result<HealedMesh> read_and_heal(const std::filesystem::path& path, const HealOp
 
 namespace {
 
+/// A segmentation's steps and their seconds, in order: [{"name", "seconds"}...].
+nlohmann::json steps_json(const SegmentResult& r) {
+    nlohmann::json steps = nlohmann::json::array();
+    for (const auto& [name, seconds] : r.step_seconds)
+        steps.push_back({{"name", name}, {"seconds", seconds}});
+    return steps;
+}
+
 nlohmann::json info_json(const InfoReport& r) {
     using nlohmann::json;
     auto vec = [](Vec3 v) { return json::array({v.x, v.y, v.z}); };
@@ -174,11 +182,10 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
     json& r = j["reverse"];
     if (rev.segmentation) {
         const SegmentResult& seg = *rev.segmentation;
-        r["segment"] = {{"method", to_string(seg.method)},
-                        {"tolerance", seg.tolerance},
-                        {"tolerance_rule", seg.tolerance_rule},
-                        {"chordal_deflection", seg.chordal_deflection},
-                        {"given_facets", seg.given_facets}};
+        r["segment"] = {
+            {"method", to_string(seg.method)},      {"tolerance", seg.tolerance},
+            {"tolerance_rule", seg.tolerance_rule}, {"chordal_deflection", seg.chordal_deflection},
+            {"given_facets", seg.given_facets},     {"steps", steps_json(seg)}};
         r["regions"] = seg.regions.size();
         json fallbacks = json::array();
         for (const ReverseFallback& f : rev.fallbacks) {
@@ -332,7 +339,8 @@ std::string to_json(const InfoReport& info, const SegmentResult& r, int indent) 
                     {"seconds",
                      {{"curvature", r.curvature_seconds},
                       {"segment", r.segment_seconds},
-                      {"fit", r.fit_seconds}}}};
+                      {"fit", r.fit_seconds}}},
+                    {"steps", steps_json(r)}};
     j["regions"] = std::move(regions);
     return j.dump(indent);
 }
@@ -366,6 +374,15 @@ std::string to_text(const SegmentResult& r, Unit unit) {
     std::snprintf(buf, sizeof buf, "seconds: curvature %.3f, segment %.3f, fit %.3f\n",
                   r.curvature_seconds, r.segment_seconds, r.fit_seconds);
     s += buf;
+    if (!r.step_seconds.empty()) {
+        s += "steps:";
+        for (std::size_t i = 0; i < r.step_seconds.size(); ++i) {
+            std::snprintf(buf, sizeof buf, "%s %s %.3f s", i ? "," : "",
+                          r.step_seconds[i].first.c_str(), r.step_seconds[i].second);
+            s += buf;
+        }
+        s += "\n";
+    }
     return s;
 }
 

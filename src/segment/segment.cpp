@@ -1815,6 +1815,14 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
         });
     c.sag = estimate_sag(c);
     result.chordal_deflection = c.sag;
+    auto step_start = t0;
+    const auto step_done = [&](const char* name) {
+        const auto now = Clock::now();
+        result.step_seconds.emplace_back(name,
+                                         std::chrono::duration<double>(now - step_start).count());
+        step_start = now;
+    };
+    step_done("edges");
     std::vector<std::uint8_t> mask;
     std::vector<Draft> drafts =
         given_regions(m, options.surfaces, options.use_surface_indices, mask, result.given_facets);
@@ -1833,15 +1841,19 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
         });
         for (auto& g : grown)
             for (Draft& d : g) drafts.push_back(std::move(d));
+        step_done("grow");
     } else {
         const auto tc = Clock::now();
         auto more = paper_regions(c, mask, options.curvature, result);
         result.curvature_seconds = seconds_since(tc);
         for (Draft& d : more) drafts.push_back(std::move(d));
+        step_done("curvature");
     }
     if (progress) progress("segment", 0.5);
     result.merges = merge_regions(c, drafts);
+    step_done("merge");
     result.freeform_groups = merge_freeform(c, drafts);
+    step_done("freeform");
     // Border refinement is the facets method's (the paper assigns facets from their vertices).
     if (options.method == SegmentMethod::kFacets) {
         corner_surfaces(c, drafts);
@@ -1852,6 +1864,7 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
         // Refining moved facets between regions after the merging: a fragment that one of its
         // neighbours' surfaces takes as it is joins it (CTC 04: 427 -> 421 faces).
         result.merges += merge_regions(c, drafts, /*fragments=*/true);
+        step_done("refine");
     }
     result.segment_seconds = seconds_since(t0) - result.curvature_seconds;
     if (progress) progress("segment", 1.0);
@@ -1859,6 +1872,7 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
     if (progress) progress("fit", 0.0);
     noise = finish(c, drafts, options.surfaces, result, options.method == SegmentMethod::kFacets);
     result.fit_seconds = seconds_since(tf);
+    step_done("fit");
     if (progress) progress("fit", 1.0);
     return result;
 }
@@ -1891,6 +1905,7 @@ Result<SegmentResult> segment(const Mesh& m, const SegmentOptions& options,
                       kNoiseFactor, sigma);
         r = run_segment(m, options, tol, buf, progress, sigma);
         r.segment_seconds += seconds;  // the earlier passes count
+        r.step_seconds.insert(r.step_seconds.begin(), {"earlier passes", seconds});
         seconds = r.curvature_seconds + r.segment_seconds + r.fit_seconds;
     }
     return r;
