@@ -63,8 +63,7 @@ void add_segment(CLI::App& app, Context& ctx) {
         "--json", o->json,
         "Print one JSON object on stdout: input, healing, mesh, segment (method, "
         "tolerances, counts, seconds, each step's seconds) and regions (id, kind, params, "
-        "facets, area, "
-        "rms, max)");
+        "facets, area, rms, max)");
     cmd->add_flag("-q,--quiet", o->quiet, "No warnings and no progress on stderr");
     cmd->callback([o, &ctx]() {
         const std::filesystem::path in(o->input), out(o->output);

@@ -385,16 +385,16 @@ enum class RuledSag {
 /// the facets: facets from rim to rim of a wide drafted wall (NIST CTC 02's cones of radius 101
 /// at 3 degrees) have generators for edges, which show no sag, and their middles sag 1.6 x the
 /// estimate from the part's curved edges, mostly small fillets held by the angular deflection.
-/// Merging a region of at most kLooseFacets facets with a cylinder or cone, twice the estimate
-/// (180 one-facet planes on four cones came back 102). A growing region taking its next ring
-/// (the other 102), no more than twice its facets' own edges' estimate (Context::facet_sag)
-/// either: a flat strip tangent to a small bore (a plane of two facets, its edges turning by
-/// nothing) lies within the tolerance of a cone or a wide cylinder through both, and NIST CTC
-/// 01, 03 and FTC 06 lost faces to them when every middle in a ring could sag twice the estimate;
-/// not for a plane of more than kLooseFacets facets, which would take a fillet with it
-/// (trimesh_featuretype meshed at 0.02 rad: a plane of 70 facets became a cone of radius 0.37 at
-/// 0.3 tolerances RMS, and the free-form wall beside it lost its face). Not across a sharp edge:
-/// the sides of a prism lie on their circumscribed cylinder within that.
+/// Twice the estimate when merging a region of at most kLooseFacets facets with a cylinder or
+/// cone (kTwice: 180 one-facet planes on four cones came back 102). When a growing region takes
+/// its next ring (kOwnEdges: the other 102), twice the estimate but no more than twice the
+/// facet's own edges' estimate (Context::facet_sag): a flat strip tangent to a small bore (a plane
+/// of two facets, its edges turning by nothing) lies within the tolerance of a cone or a wide
+/// cylinder through both, and NIST CTC 01, 03 and FTC 06 lost faces to them when every middle in a
+/// ring could sag twice the estimate; not for a plane of more than kLooseFacets facets, which would
+/// take a fillet with it (trimesh_featuretype meshed at 0.02 rad: a plane of 70 facets became a
+/// cone of radius 0.37 at 0.3 tolerances RMS, and the free-form wall beside it lost its face). Not
+/// across a sharp edge: the sides of a prism lie on their circumscribed cylinder within that.
 bool chords_agree(const Context& c, const Surface& s, std::span<const std::uint32_t> faces,
                   RuledSag ruled_sag = RuledSag::kDeflection) {
     const bool ruled = ruled_sag != RuledSag::kDeflection &&
