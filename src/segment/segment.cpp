@@ -135,9 +135,6 @@ constexpr int kPaperRefineRounds = 10;
 constexpr double kPrecisionFactor = 16;
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-    return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 FaceId fid(std::uint32_t f) { return FaceId(f); }
 
@@ -1815,12 +1812,16 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
         });
     c.sag = estimate_sag(c);
     result.chordal_deflection = c.sag;
+    // One clock for the steps; the stage totals (curvature, segment, fit) are sums of them.
     auto step_start = t0;
+    double stepped = 0;  // the steps' seconds so far
     const auto step_done = [&](const char* name) {
         const auto now = Clock::now();
-        result.step_seconds.emplace_back(name,
-                                         std::chrono::duration<double>(now - step_start).count());
+        const double seconds = std::chrono::duration<double>(now - step_start).count();
+        result.step_seconds.emplace_back(name, seconds);
         step_start = now;
+        stepped += seconds;
+        return seconds;
     };
     step_done("edges");
     std::vector<std::uint8_t> mask;
@@ -1843,11 +1844,9 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
             for (Draft& d : g) drafts.push_back(std::move(d));
         step_done("grow");
     } else {
-        const auto tc = Clock::now();
         auto more = paper_regions(c, mask, options.curvature, result);
-        result.curvature_seconds = seconds_since(tc);
         for (Draft& d : more) drafts.push_back(std::move(d));
-        step_done("curvature");
+        result.curvature_seconds = step_done("curvature");
     }
     if (progress) progress("segment", 0.5);
     result.merges = merge_regions(c, drafts);
@@ -1866,13 +1865,11 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
         result.merges += merge_regions(c, drafts, /*fragments=*/true);
         step_done("refine");
     }
-    result.segment_seconds = seconds_since(t0) - result.curvature_seconds;
+    result.segment_seconds = stepped - result.curvature_seconds;
     if (progress) progress("segment", 1.0);
-    const auto tf = Clock::now();
     if (progress) progress("fit", 0.0);
     noise = finish(c, drafts, options.surfaces, result, options.method == SegmentMethod::kFacets);
-    result.fit_seconds = seconds_since(tf);
-    step_done("fit");
+    result.fit_seconds = step_done("fit");
     if (progress) progress("fit", 1.0);
     return result;
 }
