@@ -815,6 +815,24 @@ TEST(ReverseSurfaces, WideDraftedWallsTakeTheirFacets) {
     EXPECT_LE(lone, 110u);
 }
 
+// The link rods' free-form faces, tangent to each other all round, come in fitted pieces
+// (tori, cylinders, planes) whose junctions are tangent: solving a junction's points onto both
+// surfaces slid them across the band where the two are within the tolerance of each other (up
+// to 0.13 mm, 20 x the deflection), the edge's curve left the surfaces and ten regions fell back
+// to mesh edges. A tangent junction's points are now also taken midway between the surfaces
+// along their normal, at the mesh vertex along the junction (midway_points()): two fall back.
+TEST(ReverseSurfaces, TangentJunctionsOfFittedPiecesHaveEdges) {
+    const auto path = corpus_step_dir() / "occt_linkrods.step";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "linkrods");
+    expect_solid(o, "linkrods");
+    EXPECT_LE(o.report.fallbacks.size(), 3u);
+    EXPECT_NEAR(o.report.solid_volume, o.true_volume, 1e-3 * o.true_volume);
+    ASSERT_TRUE(o.report.deviation.has_value());
+    EXPECT_LE(o.report.deviation->mesh_to_solid.max, 2 * o.deflection);
+    EXPECT_LE(o.report.deviation->solid_to_mesh.max, 2 * o.deflection);
+}
+
 TEST(ReverseStudy, DISABLED_Corpus) {
     // THREADS=n: at most n threads (results must not depend on it).
     std::optional<tbb::global_control> threads;

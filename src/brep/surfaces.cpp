@@ -864,6 +864,54 @@ std::vector<gp_Pnt> densified(const std::vector<gp_Pnt>& pts, std::span<const Su
     return out;
 }
 
+// A point of a tangent junction: `p` moved along the two surfaces' mean normal to midway
+// between them. Solving onto both (common_point()) is ill-conditioned where they are tangent:
+// the solution slides across the band where they are within the tolerance of each other, by
+// (gap) / sin(angle); along the normal it moves only by the gap, and stays at the mesh vertex
+// along the junction. Within half their gap of each surface there.
+Vec3 midway_point(const Surface& a, const Surface& b, Vec3 p) {
+    constexpr int kSteps = 4;  // each step closes the gap to second order in the angle
+    for (int k = 0; k < kSteps; ++k) {
+        const Vec3 na = normal_at(a, p);
+        Vec3 nb = normal_at(b, p);
+        if (dot(na, nb) < 0) nb = -1.0 * nb;
+        const Vec3 n = normalized(na + nb);
+        const double da = dot(closest_point(a, p) - p, n), db = dot(closest_point(b, p) - p, n);
+        p = p + 0.5 * (da + db) * n;
+    }
+    return p;
+}
+
+// The chain's points moved midway between two tangent surfaces (midway_point()), with the
+// middle of each span between two points also moved there while it is off them by more than a
+// quarter of `tolerance` (a chain of one mesh edge between two corners, on curved surfaces).
+std::vector<gp_Pnt> midway_points(const Surface& a, const Surface& b, const Mesh& m,
+                                  const std::vector<VertexId>& chain, gp_Pnt p0, gp_Pnt p1,
+                                  double tolerance) {
+    constexpr int kDepth = 4;  // up to 15 points between two chain points
+    std::vector<Vec3> pts;
+    pts.reserve(chain.size());
+    for (std::size_t k = 0; k < chain.size(); ++k) {
+        pts.push_back(k == 0                  ? vec(p0)
+                      : k + 1 == chain.size() ? vec(p1)
+                                              : midway_point(a, b, m.position(chain[k])));
+    }
+    std::vector<gp_Pnt> out;
+    const auto split = [&](auto&& self, Vec3 p, Vec3 q, int depth) -> void {
+        const Vec3 mid = 0.5 * (p + q);
+        const Vec3 w = midway_point(a, b, mid);
+        if (depth == 0 || norm(w - mid) <= 0.25 * tolerance) return;
+        self(self, p, w, depth - 1);
+        out.push_back(pnt(w));
+        self(self, w, q, depth - 1);
+    };
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+        if (k > 0) split(split, pts[k - 1], pts[k], kDepth);
+        out.push_back(pnt(pts[k]));
+    }
+    return out;
+}
+
 // The largest distance from the curve to the surfaces, at the midpoints of its spans between
 // the chain's points and at the points themselves.
 double curve_off_surfaces(const ChainCurve& c, const Surface& a, const Surface& b, int samples) {
@@ -1517,6 +1565,25 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                         if (best.deviation < 0 || t.deviation < best.deviation) best = t;
                     }
                     ok = best.deviation >= 0 && best.deviation <= max_tol;
+                    // Last, along a tangent junction, the curve through the points midway
+                    // between the two surfaces (midway_points()): where the solved points
+                    // slid across the tangency band (two fitted pieces of one free-form
+                    // face, a fillet on a slightly tilted wall). Piecewise-linear first for
+                    // a region whose wire crossed itself, as above.
+                    if (!ok && tangent) {
+                        const std::vector<gp_Pnt> mid =
+                            midway_points(sa, sb, m, ch.vertices, job.p0, job.p1, opt.tolerance);
+                        const bool linear_first = linear[ra] || linear[rb];
+                        for (int variant = 0; variant < 2 && !ok; ++variant) {
+                            ChainCurve t;
+                            if (!fitted_curve(mid, ch.closed, (variant == 0) == linear_first, t))
+                                continue;
+                            t.deviation =
+                                curve_off_surfaces(t, sa, sb, 4 * static_cast<int>(mid.size()));
+                            ok = t.deviation <= max_tol;
+                            if (ok) best = t;
+                        }
+                    }
                     if (ok) cc = best;
                 }
             } catch (const Standard_Failure&) {
