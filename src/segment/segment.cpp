@@ -1548,11 +1548,14 @@ std::vector<std::uint32_t> live_drafts(std::vector<Draft>& drafts) {
 /// kLooseRms x the deflection: not an analytic face of the file) seed groups, largest first;
 /// a group takes its smooth neighbours that are loose or small (at most kSmallRegion facets:
 /// their fit says nothing), largest first, one by one while one B-spline (fit_group()) still
-/// fits it all. A group that leaves out a loose neighbour is no face but a patch of a larger
-/// free-form area (the link rods' faces, tangent to each other all round): its borders with
-/// the rest are tangent seams between two B-splines, where the B-rep finds no edge (19
-/// fallbacks and 5.8 deflections off on the link rods), and it stays in pieces. With
-/// kFreeformMinPieces curved pieces (a few planes of a facet or two between
+/// fits it all. The first loose neighbour it cannot take ends the group's growth: a free-form
+/// face that one height field cannot cover (NIST CTC 02's blends, closed rings round drafted
+/// walls, in 5-7 pieces each) comes back in a few B-splines, and a larger free-form area (the
+/// link rods' faces, tangent to each other all round) in patches. Their borders are tangent
+/// seams between two B-splines, whose edges go through points midway between the two
+/// (docs/brep.md); until those, such a group stayed in pieces (growing on past a refused
+/// neighbour made groups steep enough to fold their net, 19 fallbacks and 5.8 deflections off on
+/// the link rods). With kFreeformMinPieces curved pieces (a few planes of a facet or two between
 /// a fillet and its corner are no evidence: NIST FTC 07 lost the ends of fillets in strips to
 /// B-splines) it becomes one region. Exact analytic faces
 /// never join: a chain of fillets stays fillets. Returns the drafts that took a group.
@@ -1605,7 +1608,6 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
         // extrusion of them is held to, as merge_freeform() holds one to the pieces' RMS).
         Pieces whole{free_parameters(fitted[s].fit.surface), fitted[s].fit.rms};
         FitResult best;
-        bool bounded = true;  // no loose neighbour left out
         while (!frontier.empty()) {
             const auto it = std::min_element(frontier.begin(), frontier.end(), larger);
             const std::uint32_t n = *it;
@@ -1622,12 +1624,10 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
                 faces = std::move(more);
                 best = std::move(r);
                 reach(n);
-            } else {
-                bounded = !seed(n);
-                if (!bounded) break;  // refused whatever else it takes
+            } else if (seed(n)) {
+                break;  // a loose neighbour it cannot take: grown as far as it goes
             }
         }
-        if (!bounded) continue;
         const auto curved = std::count_if(group.begin(), group.end(), [&](std::uint32_t p) {
             return fitted[p].fit.surface.kind != FitKind::kPlane;
         });
