@@ -76,6 +76,7 @@
 #include <cstdint>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <tuple>
 #include <unordered_map>
 #include <unordered_set>
@@ -834,34 +835,47 @@ bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, C
     return interp.IsDone() && whole(interp.Curve());
 }
 
-// The chain's points with points solved onto both surfaces inserted between them wherever
-// the straight segment strays from the surfaces by more than a quarter of `tolerance`: a coarse
-// mesh has few vertices along a curved junction (a free-form face meeting a plane).
-void densify(const gp_Pnt& p, const gp_Pnt& q, std::span<const Surface> pair, double tolerance,
-             int depth, std::vector<gp_Pnt>& out) {
-    const Vec3 mid = 0.5 * (vec(p) + vec(q));
-    const CommonPoint m = common_point(pair, mid);
-    // A sagitta beyond a quarter of the chord means the solve left the junction (tangent
-    // surfaces give it no grip along their common line): the chord stays.
-    const double moved = norm(m.point - mid);
-    if (depth > 0 && moved > 0.25 * tolerance && moved < 0.25 * p.Distance(q) &&
-        m.residual <= tolerance) {
-        densify(p, pnt(m.point), pair, tolerance, depth - 1, out);
-        out.push_back(pnt(m.point));
-        densify(pnt(m.point), q, pair, tolerance, depth - 1, out);
-    }
-}
-
-std::vector<gp_Pnt> densified(const std::vector<gp_Pnt>& pts, std::span<const Surface> pair,
-                              double tolerance) {
-    // Up to 2^5 - 1 points between two chain vertices.
-    constexpr int kDepth = 5;
+// `pts` with points inserted between each two by bisection: the middle of a span goes where
+// `onto(p, q)` puts it (std::nullopt: the span stays straight) while that moves it by more than
+// a quarter of `tolerance`, up to `depth` levels (2^depth - 1 points a span). A coarse mesh has
+// few vertices along a curved junction (a free-form face meeting a plane).
+template <class Onto>
+std::vector<gp_Pnt> bisected(const std::vector<Vec3>& pts, const Onto& onto, double tolerance,
+                             int depth) {
     std::vector<gp_Pnt> out;
+    const auto split = [&](const auto& self, Vec3 p, Vec3 q, int level) -> void {
+        if (level == 0) return;
+        const std::optional<Vec3> w = onto(p, q);
+        if (!w || !(norm(*w - 0.5 * (p + q)) > 0.25 * tolerance)) return;
+        self(self, p, *w, level - 1);
+        out.push_back(pnt(*w));
+        self(self, *w, q, level - 1);
+    };
     for (std::size_t i = 0; i < pts.size(); ++i) {
-        if (i > 0) densify(pts[i - 1], pts[i], pair, tolerance, kDepth, out);
-        out.push_back(pts[i]);
+        if (i > 0) split(split, pts[i - 1], pts[i], depth);
+        out.push_back(pnt(pts[i]));
     }
     return out;
+}
+
+// The chain's points with points solved onto both surfaces inserted between them wherever
+// the straight segment strays from the surfaces by more than a quarter of `tolerance`
+// (bisected(), up to 31 points a span).
+std::vector<gp_Pnt> densified(const std::vector<gp_Pnt>& pts, std::span<const Surface> pair,
+                              double tolerance) {
+    std::vector<Vec3> v;
+    v.reserve(pts.size());
+    for (const gp_Pnt& p : pts) v.push_back(vec(p));
+    const auto onto = [&](Vec3 p, Vec3 q) -> std::optional<Vec3> {
+        const Vec3 mid = 0.5 * (p + q);
+        const CommonPoint m = common_point(pair, mid);
+        // A sagitta beyond a quarter of the chord means the solve left the junction (tangent
+        // surfaces give it no grip along their common line): the chord stays.
+        if (!(norm(m.point - mid) < 0.25 * norm(q - p)) || !(m.residual <= tolerance))
+            return std::nullopt;
+        return m.point;
+    };
+    return bisected(v, onto, tolerance, 5);
 }
 
 // A point of a tangent junction: `p` moved along the two surfaces' mean normal to midway
@@ -884,11 +898,11 @@ Vec3 midway_point(const Surface& a, const Surface& b, Vec3 p) {
 
 // The chain's points moved midway between two tangent surfaces (midway_point()), with the
 // middle of each span between two points also moved there while it is off them by more than a
-// quarter of `tolerance` (a chain of one mesh edge between two corners, on curved surfaces).
+// quarter of `tolerance` (bisected(), up to 15 points a span: a chain of one mesh edge between
+// two corners, on curved surfaces).
 std::vector<gp_Pnt> midway_points(const Surface& a, const Surface& b, const Mesh& m,
                                   const std::vector<VertexId>& chain, gp_Pnt p0, gp_Pnt p1,
                                   double tolerance) {
-    constexpr int kDepth = 4;  // up to 15 points between two chain points
     std::vector<Vec3> pts;
     pts.reserve(chain.size());
     for (std::size_t k = 0; k < chain.size(); ++k) {
@@ -896,20 +910,10 @@ std::vector<gp_Pnt> midway_points(const Surface& a, const Surface& b, const Mesh
                       : k + 1 == chain.size() ? vec(p1)
                                               : midway_point(a, b, m.position(chain[k])));
     }
-    std::vector<gp_Pnt> out;
-    const auto split = [&](auto&& self, Vec3 p, Vec3 q, int depth) -> void {
-        const Vec3 mid = 0.5 * (p + q);
-        const Vec3 w = midway_point(a, b, mid);
-        if (depth == 0 || norm(w - mid) <= 0.25 * tolerance) return;
-        self(self, p, w, depth - 1);
-        out.push_back(pnt(w));
-        self(self, w, q, depth - 1);
+    const auto onto = [&](Vec3 p, Vec3 q) -> std::optional<Vec3> {
+        return midway_point(a, b, 0.5 * (p + q));
     };
-    for (std::size_t k = 0; k < pts.size(); ++k) {
-        if (k > 0) split(split, pts[k - 1], pts[k], kDepth);
-        out.push_back(pnt(pts[k]));
-    }
-    return out;
+    return bisected(pts, onto, tolerance, 4);
 }
 
 // The largest distance from the curve to the surfaces, at the midpoints of its spans between
