@@ -1541,6 +1541,43 @@ std::vector<std::uint32_t> live_drafts(std::vector<Draft>& drafts) {
     return order;
 }
 
+/// A facet of an extruded strip has its normal within this cosine of normal to the extrusion
+/// direction: about 2.5 degrees, as fit_bspline() asks of the normals of an extrusion (a mean
+/// squared cosine of 2e-3, kExtrusionNormals there). The pieces of the faces beside a link rods'
+/// strip lean 10 degrees and more.
+constexpr double kStripLean = 0.045;
+
+/// The direction most of `faces`' area is normal to (within kStripLean), from the cross
+/// products of the normals of pairs of adjacent facets among them (the axis a strip's facets
+/// turn about); none when no pair turns or no direction holds half the area.
+std::optional<Vec3> strip_direction(const Context& c, std::span<const std::uint32_t> faces) {
+    std::vector<Vec3> candidates;
+    std::vector<std::uint32_t> member(faces.begin(), faces.end());
+    std::sort(member.begin(), member.end());
+    for (const std::uint32_t f : faces) {
+        for (const std::uint32_t g : c.fd.adj[f]) {
+            if (g == kNone || g < f || !std::binary_search(member.begin(), member.end(), g))
+                continue;
+            const Vec3 axis = cross(c.fd.normal[f], c.fd.normal[g]);
+            if (norm(axis) > kFlatDihedral) candidates.push_back(normalized(axis));
+        }
+    }
+    double total = 0;
+    for (const std::uint32_t f : faces) total += c.fd.area[f];
+    std::optional<Vec3> best;
+    double best_area = 0.5 * total;
+    for (const Vec3& e : candidates) {
+        double a = 0;
+        for (const std::uint32_t f : faces)
+            if (std::fabs(dot(c.fd.normal[f], e)) <= kStripLean) a += c.fd.area[f];
+        if (a > best_area) {
+            best_area = a;
+            best = e;
+        }
+    }
+    return best;
+}
+
 /// Free-form faces in many analytic pieces among exact analytic faces: merge_freeform() takes
 /// a smooth component whole, and a free-form blend between fillets (NIST FTC 10: six tori and
 /// three planes) or free-form faces tangent to each other round a part (link rods: 178
@@ -1642,6 +1679,71 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
             drafts[p].faces.clear();
         }
         merged.push_back(s);
+    }
+    // Strips of small pieces no group took: a free-form face one facet across (the link rods'
+    // walls between two tangent free-form faces, 20-25 facets in a row, each a plane of its own)
+    // has no loose piece to seed it, its facets' planes fit them to rounding. Such a wall is
+    // extruded: of a smooth component of small pieces, those whose facets are all normal to one
+    // direction (strip_direction()) and chain together, at least kFreeformMinPieces of them,
+    // that one B-spline fits (within the deflection, its facets its chords) are one region. The
+    // pieces' own fits say nothing, so no RMS is asked of it, only fewer parameters than theirs.
+    const auto small = [&](std::uint32_t r) {
+        return !taken[r] && open(r) && drafts[r].faces.size() <= kSmallRegion;
+    };
+    const auto component = [&](std::uint32_t s, const auto& in, std::vector<std::uint8_t>& seen) {
+        std::vector<std::uint32_t> group{s};
+        seen[s] = 1;
+        for (std::size_t i = 0; i < group.size(); ++i) {
+            for (const std::uint32_t n : nbrs[group[i]]) {
+                if (seen[n] || !in(n)) continue;
+                seen[n] = 1;
+                group.push_back(n);
+            }
+        }
+        return group;
+    };
+    std::vector<std::uint8_t> seen(drafts.size(), 0), along(drafts.size(), 0),
+        chained(drafts.size(), 0);
+    for (std::uint32_t s = 0; s < drafts.size(); ++s) {
+        if (seen[s] || !small(s)) continue;
+        const std::vector<std::uint32_t> comp = component(s, small, seen);
+        if (comp.size() < kFreeformMinPieces) continue;
+        std::vector<std::uint32_t> comp_faces;
+        for (const std::uint32_t p : comp)
+            comp_faces.insert(comp_faces.end(), drafts[p].faces.begin(), drafts[p].faces.end());
+        const std::optional<Vec3> e = strip_direction(c, comp_faces);
+        if (!e) continue;
+        for (const std::uint32_t p : comp) {
+            const auto& pf = drafts[p].faces;
+            along[p] = std::all_of(pf.begin(), pf.end(), [&](std::uint32_t f) {
+                return std::fabs(dot(c.fd.normal[f], *e)) <= kStripLean;
+            });
+        }
+        const auto in_strip = [&](std::uint32_t r) { return along[r] != 0; };
+        for (const std::uint32_t t : comp) {
+            if (!along[t] || chained[t]) continue;
+            std::vector<std::uint32_t> group = component(t, in_strip, chained);
+            if (group.size() < kFreeformMinPieces) continue;
+            std::vector<std::uint32_t> faces;
+            Pieces whole;
+            for (const std::uint32_t p : group) {
+                faces.insert(faces.end(), drafts[p].faces.begin(), drafts[p].faces.end());
+                whole.parameters += free_parameters(fitted[p].fit.surface);
+            }
+            FitResult r = fit_group(c, faces, whole);
+            if (!r.ok || !chords_agree(c, r.surface, faces)) continue;
+            std::sort(group.begin(), group.end());
+            std::sort(faces.begin(), faces.end());
+            drafts[group.front()].faces = std::move(faces);
+            drafts[group.front()].surface = r.surface;
+            for (const std::uint32_t p : group) {
+                taken[p] = 1;
+                if (p == group.front()) continue;
+                drafts[p].alive = false;
+                drafts[p].faces.clear();
+            }
+            merged.push_back(group.front());
+        }
     }
     return merged;
 }
