@@ -882,7 +882,8 @@ std::vector<gp_Pnt> densified(const std::vector<gp_Pnt>& pts, std::span<const Su
 // between them. Solving onto both (common_point()) is ill-conditioned where they are tangent:
 // the solution slides across the band where they are within the tolerance of each other, by
 // (gap) / sin(angle); along the normal it moves only by the gap, and stays at the mesh vertex
-// along the junction. Within half their gap of each surface there.
+// along the junction. Within half their gap of each surface there. Also the last resort where
+// two surfaces meet at a shallow angle but do not cross on the chain (make_curve()).
 Vec3 midway_point(const Surface& a, const Surface& b, Vec3 p) {
     constexpr int kSteps = 4;  // each step closes the gap to second order in the angle
     for (int k = 0; k < kSteps; ++k) {
@@ -896,7 +897,7 @@ Vec3 midway_point(const Surface& a, const Surface& b, Vec3 p) {
     return p;
 }
 
-// The chain's points moved midway between two tangent surfaces (midway_point()), with the
+// The chain's points moved midway between two surfaces (midway_point()), with the
 // middle of each span between two points also moved there while it is off them by more than a
 // quarter of `tolerance` (bisected(), up to 15 points a span: a chain of one mesh edge between
 // two corners, on curved surfaces).
@@ -1569,12 +1570,16 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                         if (best.deviation < 0 || t.deviation < best.deviation) best = t;
                     }
                     ok = best.deviation >= 0 && best.deviation <= max_tol;
-                    // Last, along a tangent junction, the curve through the points midway
-                    // between the two surfaces (midway_points()): where the solved points
+                    // Last, the curve through the points midway between the two surfaces
+                    // (midway_points()): along a tangent junction, where the solved points
                     // slid across the tangency band (two fitted pieces of one free-form
-                    // face, a fillet on a slightly tilted wall). Piecewise-linear first for
-                    // a region whose wire crossed itself, as above.
-                    if (!ok && tangent) {
+                    // face, a fillet on a slightly tilted wall); and where two surfaces meet
+                    // at a shallow angle without crossing on the chain (two B-splines at
+                    // 15-18 degrees on NIST CTC 02, each within the deflection of its
+                    // points: apart by up to that along the chain, they cross off it or
+                    // nowhere near, and no intersection or solved point is on the chain).
+                    // Piecewise-linear first for a region whose wire crossed itself, as above.
+                    if (!ok) {
                         const std::vector<gp_Pnt> mid =
                             midway_points(sa, sb, m, ch.vertices, job.p0, job.p1, opt.tolerance);
                         const bool linear_first = linear[ra] || linear[rb];
