@@ -1613,7 +1613,8 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
     std::vector<std::uint32_t> seeds;
     for (std::uint32_t r = 0; r < drafts.size(); ++r)
         if (seed(r)) seeds.push_back(r);
-    if (seeds.size() < 2) return merged;
+    // A lone loose piece seeds no group; the strips below are looked for all the same.
+    if (seeds.size() < 2) seeds.clear();
     const std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
     std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
     for (const auto& [a, b] : adjacent_pairs(c, region, true)) {
