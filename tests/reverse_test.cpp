@@ -848,16 +848,16 @@ TEST(ReverseSurfaces, WideDraftedWallsTakeTheirFacets) {
 // (20-25 facets in a row) were a plane per facet, 63 one-facet regions in all; such a strip
 // of small pieces is now one extruded B-spline where one fits (merge_loose_pieces()): 26
 // one-facet regions, 99 faces, 5 fallbacks (the two walls' faces among them: bounded by their
-// mesh edges, their junctions 2-4 x the deflection off both neighbours).
+// mesh edges; the best curves along their junctions 2-4 x the deflection off both neighbours,
+// a temporary print).
 TEST(ReverseSurfaces, TangentJunctionsOfFittedPiecesHaveEdges) {
     const auto path = corpus_step_dir() / "occt_linkrods.step";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
-    const SamplePart part = corpus_part(path);
-    const SegmentResult seg = segment(build_mesh(part.mesh).value().mesh).value();
+    const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "linkrods");
+    ASSERT_TRUE(o.report.segmentation.has_value());
     std::size_t lone = 0;
-    for (const Region& g : seg.regions) lone += g.facets == 1;
+    for (const Region& g : o.report.segmentation->regions) lone += g.facets == 1;
     EXPECT_LE(lone, 30u);
-    const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "linkrods");
     expect_solid(o, "linkrods");
     EXPECT_LE(o.report.faces, 105u);
     EXPECT_LE(o.report.fallbacks.size(), 5u);

@@ -1547,9 +1547,15 @@ std::vector<std::uint32_t> live_drafts(std::vector<Draft>& drafts) {
 /// strip lean 10 degrees and more.
 constexpr double kStripLean = 0.045;
 
+/// Directions strip_direction() tries at most: each is checked against every facet, and a
+/// strip's adjacent pairs all give about the same one (a component of a few dozen small pieces
+/// has fewer pairs than this; a larger one is sampled evenly).
+constexpr std::size_t kStripCandidates = 64;
+
 /// The direction most of `faces`' area is normal to (within kStripLean), from the cross
 /// products of the normals of pairs of adjacent facets among them (the axis a strip's facets
-/// turn about); none when no pair turns or no direction holds half the area.
+/// turn about; not the normals' least eigenvector, which the pieces beside the strip in the
+/// same component tilt); none when no pair turns or no direction holds half the area.
 std::optional<Vec3> strip_direction(const Context& c, std::span<const std::uint32_t> faces) {
     std::vector<Vec3> candidates;
     std::vector<std::uint32_t> member(faces.begin(), faces.end());
@@ -1566,7 +1572,9 @@ std::optional<Vec3> strip_direction(const Context& c, std::span<const std::uint3
     for (const std::uint32_t f : faces) total += c.fd.area[f];
     std::optional<Vec3> best;
     double best_area = 0.5 * total;
-    for (const Vec3& e : candidates) {
+    const std::size_t stride = (candidates.size() + kStripCandidates - 1) / kStripCandidates;
+    for (std::size_t i = 0; i < candidates.size(); i += stride) {
+        const Vec3& e = candidates[i];
         double a = 0;
         for (const std::uint32_t f : faces)
             if (std::fabs(dot(c.fd.normal[f], e)) <= kStripLean) a += c.fd.area[f];
