@@ -21,6 +21,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <BRepAdaptor_Curve.hxx>
 #include <BRepBuilderAPI_Copy.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -29,6 +30,8 @@
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
+#include <ElSLib.hxx>
+#include <Geom2d_Line.hxx>
 #include <GeomAPI_IntSS.hxx>
 #include <GeomAPI_Interpolate.hxx>
 #include <GeomAPI_PointsToBSpline.hxx>
@@ -1038,6 +1041,200 @@ struct CurveJob {
     bool ok = false, intersected = false, touched = false, analytic = false;
 };
 
+// A face's loop on a cylinder or cone, sampled in wire order: the points' surface parameters
+// (u, the angle, unwrapped to run on continuously), where each edge's samples start, and how
+// many turns about the axis the loop makes.
+struct UnwrappedLoop {
+    std::vector<gp_Pnt2d> uv;
+    std::vector<std::size_t> edge_start;
+    int winding = 0;
+};
+
+// The (u, v) of a point on a cylinder or cone, u taken within half a turn of `near_u`.
+gp_Pnt2d revolution_uv(const GeomAdaptor_Surface& s, const gp_Pnt& p, double near_u) {
+    double u = 0, v = 0;
+    if (s.GetType() == GeomAbs_Cylinder) {
+        ElSLib::Parameters(s.Cylinder(), p, u, v);
+    } else {
+        ElSLib::Parameters(s.Cone(), p, u, v);
+    }
+    constexpr double kTurn = 2 * std::numbers::pi;
+    u += kTurn * std::round((near_u - u) / kTurn);
+    return {u, v};
+}
+
+UnwrappedLoop unwrap_loop(const GeomAdaptor_Surface& s, const std::vector<TopoDS_Edge>& loop) {
+    // Samples per edge: enough to follow a helical edge of a quarter turn within a few
+    // percent of the radius, which is all the crossing test below needs.
+    constexpr int kSamples = 12;
+    UnwrappedLoop out;
+    gp_Pnt first;
+    for (const TopoDS_Edge& e : loop) {
+        BRepAdaptor_Curve c(e);
+        const bool reversed = e.Orientation() == TopAbs_REVERSED;
+        out.edge_start.push_back(out.uv.size());
+        for (int i = 0; i < kSamples; ++i) {
+            const double t = static_cast<double>(i) / kSamples;
+            const double w = reversed ? 1 - t : t;
+            const gp_Pnt p =
+                c.Value(c.FirstParameter() + w * (c.LastParameter() - c.FirstParameter()));
+            if (out.uv.empty()) first = p;
+            out.uv.push_back(revolution_uv(s, p, out.uv.empty() ? 0.0 : out.uv.back().X()));
+        }
+    }
+    if (out.uv.empty()) return out;
+    // Back at the start: the unwrapped angle has gone round `winding` whole turns.
+    const gp_Pnt2d back = revolution_uv(s, first, out.uv.back().X());
+    out.uv.push_back(back);
+    out.winding =
+        static_cast<int>(std::lround((back.X() - out.uv.front().X()) / (2 * std::numbers::pi)));
+    return out;
+}
+
+// Whether segment a-b crosses segment c-d away from a and b.
+bool crosses(const gp_Pnt2d& a, const gp_Pnt2d& b, const gp_Pnt2d& c, const gp_Pnt2d& d) {
+    const gp_XY r = b.XY() - a.XY(), q = d.XY() - c.XY();
+    const double den = r ^ q;
+    if (std::abs(den) <= 1e-300) return false;
+    const gp_XY ac = c.XY() - a.XY();
+    const double t = (ac ^ q) / den, w = (ac ^ r) / den;
+    // The ends of a-b are on the loops: touching there is not crossing.
+    constexpr double kEnd = 1e-6;
+    return t > kEnd && t < 1 - kEnd && w >= 0 && w <= 1;
+}
+
+// The wires of a face on a cylinder or cone whose loops include two that each go once round
+// the axis (the face is a band round it), with those two joined into one wire by a seam edge
+// between a vertex of each. OpenCASCADE's face fix adds such a seam itself along one ruling,
+// but only right when each loop crosses that ruling once: the M6 screw's thread root, a
+// cylinder band whose outer loop winds down the thread, crossed the ruling at every turn and
+// the fix kept a sliver of the face. Here the seam runs straight in (u, v) between the two
+// vertices with the shortest such segment that crosses no loop; an empty result when the
+// loops are not such a band or no segment is clear.
+std::vector<std::vector<TopoDS_Edge>> seamed_band(
+    const TopoDS_Face& face, const std::vector<std::vector<TopoDS_Edge>>& wires, double tolerance) {
+    constexpr double kTurn = 2 * std::numbers::pi;
+    const Handle(Geom_Surface) surface = BRep_Tool::Surface(face);
+    const GeomAdaptor_Surface s(surface);
+    if (s.GetType() != GeomAbs_Cylinder && s.GetType() != GeomAbs_Cone) return {};
+    std::vector<UnwrappedLoop> loops;
+    std::vector<std::size_t> winding;
+    for (std::size_t i = 0; i < wires.size(); ++i) {
+        loops.push_back(unwrap_loop(s, wires[i]));
+        if (loops.back().winding != 0) winding.push_back(i);
+    }
+    if (winding.size() != 2) return {};
+    const std::size_t ia = winding[0], ib = winding[1];
+    const int w = loops[ia].winding;
+    if (std::abs(w) != 1 || loops[ib].winding != -w) return {};
+    // The fix's own seam, on the ruling u = 0, serves when each loop crosses it once.
+    const auto ruling_crossings = [&](const UnwrappedLoop& l) {
+        std::int64_t n = 0;
+        for (std::size_t j = 0; j + 1 < l.uv.size(); ++j) {
+            n += std::abs(static_cast<std::int64_t>(std::floor(l.uv[j + 1].X() / kTurn)) -
+                          static_cast<std::int64_t>(std::floor(l.uv[j].X() / kTurn)));
+        }
+        return n;
+    };
+    if (ruling_crossings(loops[ia]) <= 1 && ruling_crossings(loops[ib]) <= 1) return {};
+
+    // Every loop's samples, repeated a turn either way as far as the two loops reach.
+    double u_lo = 1e300, u_hi = -1e300;
+    for (const std::size_t i : {ia, ib}) {
+        for (const gp_Pnt2d& p : loops[i].uv) {
+            u_lo = std::min(u_lo, p.X());
+            u_hi = std::max(u_hi, p.X());
+        }
+    }
+    const int copies = static_cast<int>(std::ceil((u_hi - u_lo) / kTurn)) + 1;
+    const auto clear = [&](const gp_Pnt2d& a, const gp_Pnt2d& b) {
+        for (const UnwrappedLoop& l : loops) {
+            for (int k = -copies; k <= copies; ++k) {
+                const gp_Vec2d shift(k * kTurn, 0);
+                for (std::size_t j = 0; j + 1 < l.uv.size(); ++j) {
+                    if (crosses(a, b, l.uv[j].Translated(shift), l.uv[j + 1].Translated(shift))) {
+                        return false;
+                    }
+                }
+            }
+        }
+        return true;
+    };
+    // The segment's length on the surface, from a few points along it.
+    const auto length = [&](const gp_Pnt2d& a, const gp_Pnt2d& b) {
+        constexpr int kSteps = 8;
+        double len = 0;
+        gp_Pnt prev = s.Value(a.X(), a.Y());
+        for (int i = 1; i <= kSteps; ++i) {
+            const gp_XY q = a.XY() + (b.XY() - a.XY()) * (static_cast<double>(i) / kSteps);
+            const gp_Pnt p = s.Value(q.X(), q.Y());
+            len += p.Distance(prev);
+            prev = p;
+        }
+        return len;
+    };
+    double best = 1e300;
+    std::size_t best_a = 0, best_b = 0;
+    gp_Pnt2d best_pa, best_pb;
+    for (std::size_t ea = 0; ea < wires[ia].size(); ++ea) {
+        const gp_Pnt2d pa = loops[ia].uv[loops[ia].edge_start[ea]];
+        for (std::size_t eb = 0; eb < wires[ib].size(); ++eb) {
+            const gp_Pnt2d b0 = loops[ib].uv[loops[ib].edge_start[eb]];
+            for (int k = -1; k <= 1; ++k) {
+                // b's point taken the nearest turn to a's, then a turn either way.
+                const double shift = kTurn * (std::round((pa.X() - b0.X()) / kTurn) + k);
+                const gp_Pnt2d pb(b0.X() + shift, b0.Y());
+                const double len = length(pa, pb);
+                if (len >= best || !clear(pa, pb)) continue;
+                best = len;
+                best_a = ea;
+                best_b = eb;
+                best_pa = pa;
+                best_pb = pb;
+            }
+        }
+    }
+    if (best == 1e300) return {};
+
+    // The seam from b's vertex to a's; used forward (b to a) on the pcurve through those
+    // points, and reversed (a to b) a turn along, where loop a has brought the wire.
+    const TopoDS_Vertex va = TopExp::FirstVertex(wires[ia][best_a], true);
+    const TopoDS_Vertex vb = TopExp::FirstVertex(wires[ib][best_b], true);
+    const gp_Pnt2d pa = revolution_uv(s, BRep_Tool::Pnt(va), best_pa.X());
+    const gp_Pnt2d pb = revolution_uv(s, BRep_Tool::Pnt(vb), best_pb.X());
+    const double span = pa.Distance(pb);
+    if (span <= Precision::PConfusion()) return {};
+    Handle(Geom2d_Line) forward = new Geom2d_Line(pb, gp_Dir2d(pa.XY() - pb.XY()));
+    Handle(Geom2d_Curve) backward =
+        Handle(Geom2d_Curve)::DownCast(forward->Translated(gp_Vec2d(w * kTurn, 0)));
+    BRep_Builder B;
+    TopoDS_Edge seam;
+    B.MakeEdge(seam);
+    B.UpdateEdge(seam, forward, face, tolerance);
+    B.Range(seam, 0, span);
+    B.Add(seam, vb.Oriented(TopAbs_FORWARD));
+    B.Add(seam, va.Oriented(TopAbs_REVERSED));
+    if (!BRepLib::BuildCurve3d(seam, tolerance)) return {};
+    B.UpdateEdge(seam, forward, backward, face, tolerance);
+    B.Range(seam, 0, span);
+
+    // Loop a from its vertex round to it, the seam back to b, loop b round, the seam to a.
+    std::vector<TopoDS_Edge> band;
+    for (std::size_t i = 0; i < wires[ia].size(); ++i) {
+        band.push_back(wires[ia][(best_a + i) % wires[ia].size()]);
+    }
+    band.push_back(TopoDS::Edge(seam.Reversed()));
+    for (std::size_t i = 0; i < wires[ib].size(); ++i) {
+        band.push_back(wires[ib][(best_b + i) % wires[ib].size()]);
+    }
+    band.push_back(seam);
+    std::vector<std::vector<TopoDS_Edge>> out{std::move(band)};
+    for (std::size_t i = 0; i < wires.size(); ++i) {
+        if (i != ia && i != ib) out.push_back(wires[i]);
+    }
+    return out;
+}
+
 // The geometry one build round computed, which the next reuses while what it was computed
 // from is unchanged (build_surface_brep): a round differs from the one before only around the
 // regions that failed, and solving every corner and intersecting every pair of surfaces again
@@ -1840,6 +2037,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 } else {
                     B.MakeFace(F, geom[r], kMinTolerance);
                     std::size_t wire_edges_in = 0;
+                    std::vector<std::vector<TopoDS_Edge>> wires;
                     for (const auto& loop : bd.loops[r]) {
                         // The loop, in the surface's own orientation.
                         std::vector<TopoDS_Edge> wire_edges;
@@ -1858,6 +2056,13 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                             for (TopoDS_Edge& e : wire_edges) e.Reverse();
                         }
                         wire_edges_in += wire_edges.size();
+                        wires.push_back(std::move(wire_edges));
+                    }
+                    if (auto band = seamed_band(F, wires, max_tol); !band.empty()) {
+                        wires = std::move(band);
+                        ++wire_edges_in;  // the seam
+                    }
+                    for (const auto& wire_edges : wires) {
                         TopoDS_Wire W;
                         B.MakeWire(W);
                         for (const TopoDS_Edge& e : wire_edges) B.Add(W, e);
