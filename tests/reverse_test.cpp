@@ -448,13 +448,13 @@ TEST(ReverseSurfaces, CoarseFilletFansAreChords) {
 
 // A region whose exact face cannot be built (no edge curve with a neighbour, a wire that
 // crosses itself, a face that fails read back) comes back as one face on its own surface,
-// bounded by the mesh edges of its border, not as its facets: the screw's two thread flanks
-// (no kind here describes a helix; B-splines fit them, their edges with the cylinders do not
-// solve) were 916 facets, CTC 01's small cone was 9. Those faces are within the chordal
-// deflection like every other.
+// bounded by the mesh edges of its border, not as its facets: CTC 01's small cone was 9
+// facets, CTC 05's one 11. (The occt_screw's thread flanks, 916 facets once, were the first
+// such faces; its last fallback builds now, see ABandFaceThatFailsTakesItsOwnSeam.)
+// Those faces are within the chordal deflection like every other.
 TEST(ReverseSurfaces, FallbackRegionsKeepTheirSurfaces) {
     if (corpus_steps().empty()) GTEST_SKIP() << "no corpus at " << corpus_step_dir();
-    for (const char* name : {"occt_screw.step", "nist_ctc_01_asme1_rd.stp"}) {
+    for (const char* name : {"nist_ctc_01_asme1_rd.stp", "nist_ctc_05_asme1_rd.stp"}) {
         const Outcome o =
             reverse_part(corpus_part(corpus_step_dir() / name), false, ReverseMethod::kAuto, name);
         expect_solid(o, name);
@@ -463,14 +463,30 @@ TEST(ReverseSurfaces, FallbackRegionsKeepTheirSurfaces) {
             EXPECT_TRUE(f.mesh_edges) << name << ": region " << f.region << " as facets";
         }
         EXPECT_EQ(o.report.faces_by_kind.count("facet"), 0u) << name;
-        EXPECT_LE(std::abs(static_cast<double>(o.report.faces) - static_cast<double>(o.true_faces)),
-                  std::max(1.0, 0.05 * static_cast<double>(o.true_faces)))
+        EXPECT_LE(std::abs(static_cast<double>(o.report.faces) -
+                           static_cast<double>(o.one_surface_faces)),
+                  std::max(1.0, 0.05 * static_cast<double>(o.one_surface_faces)))
             << name;
         expect_near_the_part(o, name);
         if (o.report.deviation) {
             EXPECT_EQ(o.report.deviation->faces_without_triangles, 0u) << name;
         }
     }
+}
+
+// The occt_screw's countersunk head: a cone band round the axis whose top loop runs down and
+// across the slot. ShapeFix_Face's seam on the ruling u = 0 dropped 6 of its 9 edges and the
+// cone fell back (one face on mesh edges, the volume 0.062 % short). A band face that fails
+// with the fix's seam is built again with its own (seamed_band()): no fallback, the volume
+// within 0.001 % of the exact solid's.
+TEST(ReverseSurfaces, ABandFaceThatFailsTakesItsOwnSeam) {
+    const auto path = corpus_step_dir() / "occt_screw.step";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "screw");
+    expect_solid(o, "screw");
+    for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << f.reason;
+    EXPECT_NEAR(o.report.solid_volume, o.true_volume, 1e-5 * o.true_volume);
+    expect_near_the_part(o, "screw");
 }
 
 // The M6 screw's thread (~270 regions of cones, tori and planes along a helix): the face of
