@@ -448,13 +448,14 @@ TEST(ReverseSurfaces, CoarseFilletFansAreChords) {
 
 // A region whose exact face cannot be built (no edge curve with a neighbour, a wire that
 // crosses itself, a face that fails read back) comes back as one face on its own surface,
-// bounded by the mesh edges of its border, not as its facets: CTC 01's small cone was 9
-// facets, CTC 05's one 11. (The occt_screw's thread flanks, 916 facets once, were the first
-// such faces; its last fallback builds now, see ABandFaceThatFailsTakesItsOwnSeam.)
+// bounded by the mesh edges of its border, not as its facets: FTC 07's cylinder that BRepMesh
+// cannot triangulate and its two tori. (The occt_screw's thread flanks, 916 facets once, and
+// the cones of CTC 01 and CTC 05 were such faces; they build now, see
+// ABandFaceThatFailsTakesItsOwnSeam and ACapRoundAConesApexGetsASeamAndADegeneratedEdge.)
 // Those faces are within the chordal deflection like every other.
 TEST(ReverseSurfaces, FallbackRegionsKeepTheirSurfaces) {
     if (corpus_steps().empty()) GTEST_SKIP() << "no corpus at " << corpus_step_dir();
-    for (const char* name : {"nist_ctc_01_asme1_rd.stp", "nist_ctc_05_asme1_rd.stp"}) {
+    for (const char* name : {"nist_ftc_07_asme1_rd.stp"}) {
         const Outcome o =
             reverse_part(corpus_part(corpus_step_dir() / name), false, ReverseMethod::kAuto, name);
         expect_solid(o, name);
@@ -487,6 +488,21 @@ TEST(ReverseSurfaces, ABandFaceThatFailsTakesItsOwnSeam) {
     for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << f.reason;
     EXPECT_NEAR(o.report.solid_volume, o.true_volume, 1e-5 * o.true_volume);
     expect_near_the_part(o, "screw");
+}
+
+// CTC 01's and CTC 05's drill points, cones cut across by a 2 mm slot: each region is a cap
+// round its cone's apex, one loop going once round the axis. ShapeFix_Face left the wire open
+// (BRepCheck_NotClosed) and the cone fell back. After that failure the face is built again
+// with a seam up the ruling from the apex to a vertex of the loop and a degenerated edge at the
+// apex (seamed_cap()): no fallback on either part, CTC 04 5 -> 3.
+TEST(ReverseSurfaces, ACapRoundAConesApexGetsASeamAndADegeneratedEdge) {
+    const auto path = corpus_step_dir() / "nist_ctc_01_asme1_rd.stp";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "ctc01");
+    expect_solid(o, "ctc01");
+    for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << f.reason;
+    EXPECT_EQ(o.report.faces, o.true_faces);
+    expect_near_the_part(o, "ctc01");
 }
 
 // The M6 screw's thread (~270 regions of cones, tori and planes along a helix): the face of

@@ -1103,6 +1103,104 @@ bool crosses(const gp_Pnt2d& a, const gp_Pnt2d& b, const gp_Pnt2d& c, const gp_P
     return t > kEnd && t < 1 - kEnd && w >= 0 && w <= 1;
 }
 
+// Whether segment a-b crosses none of `loops`, each repeated `copies` turns either way.
+bool clear_of_loops(const gp_Pnt2d& a, const gp_Pnt2d& b, const std::vector<UnwrappedLoop>& loops,
+                    int copies) {
+    constexpr double kTurn = 2 * std::numbers::pi;
+    for (const UnwrappedLoop& l : loops) {
+        for (int k = -copies; k <= copies; ++k) {
+            const gp_Vec2d shift(k * kTurn, 0);
+            for (std::size_t j = 0; j + 1 < l.uv.size(); ++j) {
+                if (crosses(a, b, l.uv[j].Translated(shift), l.uv[j + 1].Translated(shift))) {
+                    return false;
+                }
+            }
+        }
+    }
+    return true;
+}
+
+// The wires of a face on a cone with one loop that goes once round the axis (the face is a cap
+// round the apex: CTC 01's and CTC 05's drill points, cut across by a slot), with that loop
+// closed by a seam along the ruling from one of its vertices to the apex and a degenerated
+// edge there, which is how OpenCASCADE bounds a face at a cone's apex; ShapeFix_Face left such
+// wires open (BRepCheck_NotClosed). The seam from the nearest vertex to the apex whose ruling
+// crosses no loop; an empty result when the loops are not such a cap or no ruling is clear.
+std::vector<std::vector<TopoDS_Edge>> seamed_cap(const TopoDS_Face& face,
+                                                 const std::vector<std::vector<TopoDS_Edge>>& wires,
+                                                 const std::vector<UnwrappedLoop>& loops,
+                                                 std::size_t ia, double tolerance) {
+    constexpr double kTurn = 2 * std::numbers::pi;
+    const GeomAdaptor_Surface s(BRep_Tool::Surface(face));
+    const gp_Cone cone = s.Cone();
+    const gp_Pnt apex = cone.Apex();
+    double u_apex = 0, v_apex = 0;
+    ElSLib::Parameters(cone, apex, u_apex, v_apex);
+    double u_lo = 1e300, u_hi = -1e300;
+    for (const gp_Pnt2d& p : loops[ia].uv) {
+        u_lo = std::min(u_lo, p.X());
+        u_hi = std::max(u_hi, p.X());
+    }
+    const int copies = static_cast<int>(std::ceil((u_hi - u_lo) / kTurn)) + 1;
+    double best = 1e300;
+    std::size_t best_a = 0;
+    for (std::size_t ea = 0; ea < wires[ia].size(); ++ea) {
+        const gp_Pnt2d pa = loops[ia].uv[loops[ia].edge_start[ea]];
+        const double len = std::abs(pa.Y() - v_apex);
+        if (len >= best || !clear_of_loops(gp_Pnt2d(pa.X(), v_apex), pa, loops, copies)) continue;
+        best = len;
+        best_a = ea;
+    }
+    if (best == 1e300) return {};
+    const int w = loops[ia].winding;
+    const TopoDS_Vertex va = TopExp::FirstVertex(wires[ia][best_a], true);
+    const gp_Pnt2d pa =
+        revolution_uv(s, BRep_Tool::Pnt(va), loops[ia].uv[loops[ia].edge_start[best_a]].X());
+    if (std::abs(pa.Y() - v_apex) <= Precision::PConfusion()) return {};
+    BRep_Builder B;
+    TopoDS_Vertex tip;
+    B.MakeVertex(tip, apex, tolerance);
+    // The seam from the apex up the ruling to the vertex: forward from the apex, and reversed
+    // a turn along, where the loop has brought the wire.
+    const gp_Pnt2d foot(pa.X(), v_apex);
+    Handle(Geom2d_Line) forward = new Geom2d_Line(foot, gp_Dir2d(0, pa.Y() > v_apex ? 1 : -1));
+    Handle(Geom2d_Curve) backward =
+        Handle(Geom2d_Curve)::DownCast(forward->Translated(gp_Vec2d(w * kTurn, 0)));
+    const double span = std::abs(pa.Y() - v_apex);
+    TopoDS_Edge seam;
+    B.MakeEdge(seam);
+    B.UpdateEdge(seam, forward, face, tolerance);
+    B.Range(seam, 0, span);
+    B.Add(seam, tip.Oriented(TopAbs_FORWARD));
+    B.Add(seam, va.Oriented(TopAbs_REVERSED));
+    if (!BRepLib::BuildCurve3d(seam, tolerance)) return {};
+    B.UpdateEdge(seam, forward, backward, face, tolerance);
+    B.Range(seam, 0, span);
+    // The apex, a turn back from where the reversed seam arrives to where the seam leaves.
+    TopoDS_Edge degenerate;
+    B.MakeEdge(degenerate);
+    Handle(Geom2d_Line) round =
+        new Geom2d_Line(gp_Pnt2d(pa.X() + w * kTurn, v_apex), gp_Dir2d(w > 0 ? -1 : 1, 0));
+    B.UpdateEdge(degenerate, round, face, tolerance);
+    B.Range(degenerate, 0, kTurn);
+    B.Degenerated(degenerate, true);
+    B.Add(degenerate, tip.Oriented(TopAbs_FORWARD));
+    B.Add(degenerate, tip.Oriented(TopAbs_REVERSED));
+
+    std::vector<TopoDS_Edge> cap;
+    for (std::size_t i = 0; i < wires[ia].size(); ++i) {
+        cap.push_back(wires[ia][(best_a + i) % wires[ia].size()]);
+    }
+    cap.push_back(TopoDS::Edge(seam.Reversed()));
+    cap.push_back(degenerate);
+    cap.push_back(seam);
+    std::vector<std::vector<TopoDS_Edge>> out{std::move(cap)};
+    for (std::size_t i = 0; i < wires.size(); ++i) {
+        if (i != ia) out.push_back(wires[i]);
+    }
+    return out;
+}
+
 // The wires of a face on a cylinder or cone whose loops include two that each go once round
 // the axis (the face is a band round it), with those two joined into one wire by a seam edge
 // between a vertex of each. OpenCASCADE's face fix adds such a seam itself along one ruling,
@@ -1130,6 +1228,13 @@ std::vector<std::vector<TopoDS_Edge>> seamed_band(
     for (std::size_t i = 0; i < wires.size(); ++i) {
         loops.push_back(unwrap_loop(s, wires[i]));
         if (loops.back().winding != 0) winding.push_back(i);
+    }
+    if (winding.size() == 1 && std::abs(loops[winding[0]].winding) == 1 &&
+        s.GetType() == GeomAbs_Cone) {
+        // A cap round the apex, with its own seam only after the fix's failed.
+        is_band = true;
+        return always ? seamed_cap(face, wires, loops, winding[0], tolerance)
+                      : std::vector<std::vector<TopoDS_Edge>>{};
     }
     if (winding.size() != 2) return {};
     const std::size_t ia = winding[0], ib = winding[1];
@@ -1160,17 +1265,7 @@ std::vector<std::vector<TopoDS_Edge>> seamed_band(
     }
     const int copies = static_cast<int>(std::ceil((u_hi - u_lo) / kTurn)) + 1;
     const auto clear = [&](const gp_Pnt2d& a, const gp_Pnt2d& b) {
-        for (const UnwrappedLoop& l : loops) {
-            for (int k = -copies; k <= copies; ++k) {
-                const gp_Vec2d shift(k * kTurn, 0);
-                for (std::size_t j = 0; j + 1 < l.uv.size(); ++j) {
-                    if (crosses(a, b, l.uv[j].Translated(shift), l.uv[j + 1].Translated(shift))) {
-                        return false;
-                    }
-                }
-            }
-        }
-        return true;
+        return clear_of_loops(a, b, loops, copies);
     };
     // The segment's length on the surface, from a few points along it.
     const auto length = [&](const gp_Pnt2d& a, const gp_Pnt2d& b) {
@@ -1325,8 +1420,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     std::vector<std::int32_t> absorbed(nr, -1);
     // Regions whose tangent junctions take piecewise-linear edges (after a self-crossing wire).
     std::vector<std::uint8_t> linear(nr, 0);
-    // Regions whose face is a band round a cylinder's or cone's axis (seamed_band), and those
-    // of them whose face takes the band's own seam after it failed with the fix's.
+    // Regions whose face is a band round a cylinder's or cone's axis, or a cap round a cone's
+    // apex (seamed_band), and those of them whose face takes its own seam after it failed with
+    // the fix's.
     std::vector<std::uint8_t> is_band_face(nr, 0), own_seam(nr, 0);
     // Corners (mesh vertex ids) solved without it after a face or chain at them failed with it
     // (a corner moved along a coarse mesh's contact band can pass its chain's next point).
@@ -2080,7 +2176,12 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     if (auto seamed = seamed_band(F, wires, max_tol, own_seam[r] != 0, is_band);
                         !seamed.empty()) {
                         wires = std::move(seamed);
-                        ++wire_edges_in;  // the seam
+                        // With the seam (and the apex's degenerated edge).
+                        TopTools_IndexedMapOfShape distinct;
+                        for (const auto& we : wires) {
+                            for (const TopoDS_Edge& e : we) distinct.Add(e);
+                        }
+                        wire_edges_in = static_cast<std::size_t>(distinct.Extent());
                     }
                     is_band_face[r] = is_band ? 1 : 0;
                     for (const auto& wire_edges : wires) {
