@@ -905,13 +905,15 @@ TEST(ReverseSurfaces, TangentJunctionsOfFittedPiecesHaveEdges) {
 // such curve ran the long way round, a 271-degree arc for a junction of 89, on both surfaces
 // but 2.5 mm off the chain, and the cone's face did not close (BRepCheck_NotClosed); so did a
 // torus's. A tangency curve is now held to twice max_tol of its points (strays_from()): 5 -> 3
-// fallbacks, the volume -0.072 % -> +0.003 % of the exact solid's.
+// fallbacks, the volume -0.072 % -> +0.003 % of the exact solid's. Then 3 -> 2: a corner blend
+// fitted as a spindle torus (minor radius 21.7 over major 6.6) is a cap round the point where
+// the torus meets its axis, closed by seamed_cap() like a cone's apex.
 TEST(ReverseSurfaces, TangencyCurvesStayAlongTheirJunction) {
     const auto path = corpus_step_dir() / "nist_ftc_07_asme1_rd.stp";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
     const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "ftc07");
     expect_solid(o, "ftc07");
-    EXPECT_LE(o.report.fallbacks.size(), 3u);
+    EXPECT_LE(o.report.fallbacks.size(), 2u);
     EXPECT_NEAR(o.report.solid_volume, o.true_volume, 2e-4 * o.true_volume);
     expect_near_the_part(o, "ftc07");
 }

@@ -1048,22 +1048,30 @@ struct UnwrappedLoop {
     std::vector<gp_Pnt2d> uv;
     std::vector<std::size_t> edge_start;
     int winding = 0;
+    int tube_winding = 0;  // a torus's: turns round its tube (v)
 };
 
-// The (u, v) of a point on a cylinder or cone, u taken within half a turn of `near_u`.
-gp_Pnt2d revolution_uv(const GeomAdaptor_Surface& s, const gp_Pnt& p, double near_u) {
+// The (u, v) of a point on a cylinder, cone or torus, each periodic parameter taken within
+// half a turn of `near`'s.
+gp_Pnt2d revolution_uv(const GeomAdaptor_Surface& s, const gp_Pnt& p, const gp_Pnt2d& near) {
+    constexpr double kTurn = 2 * std::numbers::pi;
     double u = 0, v = 0;
     if (s.GetType() == GeomAbs_Cylinder) {
         ElSLib::Parameters(s.Cylinder(), p, u, v);
-    } else {
+    } else if (s.GetType() == GeomAbs_Cone) {
         ElSLib::Parameters(s.Cone(), p, u, v);
+    } else {
+        ElSLib::Parameters(s.Torus(), p, u, v);
+        v += kTurn * std::round((near.Y() - v) / kTurn);
     }
-    constexpr double kTurn = 2 * std::numbers::pi;
-    u += kTurn * std::round((near_u - u) / kTurn);
+    u += kTurn * std::round((near.X() - u) / kTurn);
     return {u, v};
 }
 
-UnwrappedLoop unwrap_loop(const GeomAdaptor_Surface& s, const std::vector<TopoDS_Edge>& loop) {
+// `start`: where the first point's periodic parameters are taken near (a torus's loops all
+// near one, so that a band's two are on the same turn of the tube).
+UnwrappedLoop unwrap_loop(const GeomAdaptor_Surface& s, const std::vector<TopoDS_Edge>& loop,
+                          const gp_Pnt2d& start) {
     // Samples per edge: enough to follow a helical edge of a quarter turn within a few
     // percent of the radius, which is all the crossing test below needs.
     constexpr int kSamples = 12;
@@ -1079,15 +1087,17 @@ UnwrappedLoop unwrap_loop(const GeomAdaptor_Surface& s, const std::vector<TopoDS
             const gp_Pnt p =
                 c.Value(c.FirstParameter() + w * (c.LastParameter() - c.FirstParameter()));
             if (out.uv.empty()) first = p;
-            out.uv.push_back(revolution_uv(s, p, out.uv.empty() ? 0.0 : out.uv.back().X()));
+            out.uv.push_back(revolution_uv(s, p, out.uv.empty() ? start : out.uv.back()));
         }
     }
     if (out.uv.empty()) return out;
     // Back at the start: the unwrapped angle has gone round `winding` whole turns.
-    const gp_Pnt2d back = revolution_uv(s, first, out.uv.back().X());
+    const gp_Pnt2d back = revolution_uv(s, first, out.uv.back());
     out.uv.push_back(back);
     out.winding =
         static_cast<int>(std::lround((back.X() - out.uv.front().X()) / (2 * std::numbers::pi)));
+    out.tube_winding =
+        static_cast<int>(std::lround((back.Y() - out.uv.front().Y()) / (2 * std::numbers::pi)));
     return out;
 }
 
@@ -1124,7 +1134,9 @@ bool clear_of_loops(const gp_Pnt2d& a, const gp_Pnt2d& b, const std::vector<Unwr
 // round the apex: CTC 01's and CTC 05's drill points, cut across by a slot), with that loop
 // closed by a seam along the ruling from one of its vertices to the apex and a degenerated
 // edge there, which is how OpenCASCADE bounds a face at a cone's apex; ShapeFix_Face left such
-// wires open (BRepCheck_NotClosed). The seam from the nearest vertex to the apex whose ruling
+// wires open (BRepCheck_NotClosed). A spindle torus (minor radius over major, FTC 07's corner
+// blends) has two such points on its axis, where R + r cos v = 0; a cap there is closed the same
+// way, the seam along a meridian. The seam from the nearest vertex to the point whose ruling
 // crosses no loop; an empty result when the loops are not such a cap or no ruling is clear.
 std::vector<std::vector<TopoDS_Edge>> seamed_cap(const TopoDS_Face& face,
                                                  const std::vector<std::vector<TopoDS_Edge>>& wires,
@@ -1132,10 +1144,25 @@ std::vector<std::vector<TopoDS_Edge>> seamed_cap(const TopoDS_Face& face,
                                                  std::size_t ia, double tolerance) {
     constexpr double kTurn = 2 * std::numbers::pi;
     const GeomAdaptor_Surface s(BRep_Tool::Surface(face));
-    const gp_Cone cone = s.Cone();
-    const gp_Pnt apex = cone.Apex();
-    double u_apex = 0, v_apex = 0;
-    ElSLib::Parameters(cone, apex, u_apex, v_apex);
+    double v_apex = 0;
+    if (s.GetType() == GeomAbs_Cone) {
+        double u_apex = 0;
+        ElSLib::Parameters(s.Cone(), s.Cone().Apex(), u_apex, v_apex);
+    } else {
+        const gp_Torus t = s.Torus();
+        if (t.MinorRadius() <= t.MajorRadius()) return {};
+        // Of the two points, the one nearer the loop (v unwrapped as the loop's).
+        const double v0 = std::acos(-t.MajorRadius() / t.MinorRadius());
+        const double v_loop = loops[ia].uv.front().Y();
+        double best_gap = 1e300;
+        for (const double c : {v0, -v0}) {
+            const double v = c + kTurn * std::round((v_loop - c) / kTurn);
+            if (std::abs(v - v_loop) < best_gap) {
+                best_gap = std::abs(v - v_loop);
+                v_apex = v;
+            }
+        }
+    }
     double u_lo = 1e300, u_hi = -1e300;
     for (const gp_Pnt2d& p : loops[ia].uv) {
         u_lo = std::min(u_lo, p.X());
@@ -1155,11 +1182,11 @@ std::vector<std::vector<TopoDS_Edge>> seamed_cap(const TopoDS_Face& face,
     const int w = loops[ia].winding;
     const TopoDS_Vertex va = TopExp::FirstVertex(wires[ia][best_a], true);
     const gp_Pnt2d pa =
-        revolution_uv(s, BRep_Tool::Pnt(va), loops[ia].uv[loops[ia].edge_start[best_a]].X());
+        revolution_uv(s, BRep_Tool::Pnt(va), loops[ia].uv[loops[ia].edge_start[best_a]]);
     if (std::abs(pa.Y() - v_apex) <= Precision::PConfusion()) return {};
     BRep_Builder B;
     TopoDS_Vertex tip;
-    B.MakeVertex(tip, apex, tolerance);
+    B.MakeVertex(tip, s.Value(pa.X(), v_apex), tolerance);
     // The seam from the apex up the ruling to the vertex: forward from the apex, and reversed
     // a turn along, where the loop has brought the wire.
     const gp_Pnt2d foot(pa.X(), v_apex);
@@ -1222,15 +1249,20 @@ std::vector<std::vector<TopoDS_Edge>> seamed_band(
     is_band = false;
     const Handle(Geom_Surface) surface = BRep_Tool::Surface(face);
     const GeomAdaptor_Surface s(surface);
-    if (s.GetType() != GeomAbs_Cylinder && s.GetType() != GeomAbs_Cone) return {};
+    if (s.GetType() != GeomAbs_Cylinder && s.GetType() != GeomAbs_Cone &&
+        s.GetType() != GeomAbs_Torus) {
+        return {};
+    }
     std::vector<UnwrappedLoop> loops;
     std::vector<std::size_t> winding;
     for (std::size_t i = 0; i < wires.size(); ++i) {
-        loops.push_back(unwrap_loop(s, wires[i]));
+        loops.push_back(unwrap_loop(
+            s, wires[i], loops.empty() ? gp_Pnt2d() : gp_Pnt2d(0, loops.front().uv.front().Y())));
+        if (loops.back().tube_winding != 0) return {};  // round a torus's tube: not a band
         if (loops.back().winding != 0) winding.push_back(i);
     }
     if (winding.size() == 1 && std::abs(loops[winding[0]].winding) == 1 &&
-        s.GetType() == GeomAbs_Cone) {
+        s.GetType() != GeomAbs_Cylinder) {
         // A cap round the apex, with its own seam only after the fix's failed.
         is_band = true;
         return always ? seamed_cap(face, wires, loops, winding[0], tolerance)
@@ -1307,8 +1339,8 @@ std::vector<std::vector<TopoDS_Edge>> seamed_band(
     // points, and reversed (a to b) a turn along, where loop a has brought the wire.
     const TopoDS_Vertex va = TopExp::FirstVertex(wires[ia][best_a], true);
     const TopoDS_Vertex vb = TopExp::FirstVertex(wires[ib][best_b], true);
-    const gp_Pnt2d pa = revolution_uv(s, BRep_Tool::Pnt(va), best_pa.X());
-    const gp_Pnt2d pb = revolution_uv(s, BRep_Tool::Pnt(vb), best_pb.X());
+    const gp_Pnt2d pa = revolution_uv(s, BRep_Tool::Pnt(va), best_pa);
+    const gp_Pnt2d pb = revolution_uv(s, BRep_Tool::Pnt(vb), best_pb);
     const double span = pa.Distance(pb);
     if (span <= Precision::PConfusion()) return {};
     Handle(Geom2d_Line) forward = new Geom2d_Line(pb, gp_Dir2d(pa.XY() - pb.XY()));
