@@ -505,6 +505,20 @@ TEST(ReverseSurfaces, ACapRoundAConesApexGetsASeamAndADegeneratedEdge) {
     expect_near_the_part(o, "ctc01");
 }
 
+// Where four surfaces meet, segmentation can leave two corners of three joined by a one-edge
+// chain; solved onto their surfaces the two land 0.0001-0.04 mm apart on CTC 04 (deflection
+// 0.94 mm), and an edge that short made the wires of both faces along it cross themselves: three
+// of its fillets fell back. A chain whose solved ends are within the surfaces' tolerance of each
+// other is now one vertex and no edge: no fallback.
+TEST(ReverseSurfaces, CornersOfFourSurfacesAreOneVertex) {
+    const auto path = corpus_step_dir() / "nist_ctc_04_asme1_rd.stp";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "ctc04");
+    expect_solid(o, "ctc04");
+    for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << f.reason;
+    expect_near_the_part(o, "ctc04");
+}
+
 // The M6 screw's thread (~270 regions of cones, tori and planes along a helix): the face of
 // its threaded core kept 11 of its 158 edges after ShapeFix_Face dropped a wire it found
 // outside the surface's bounds; that face passed its check, its neighbours' edges stayed
