@@ -238,6 +238,13 @@ void expect_near_the_part(const Outcome& o, const std::string& tag) {
     EXPECT_LE(o.report.deviation->solid_to_mesh.max, 2 * o.deflection) << tag;
 }
 
+// A valid closed solid with no fallback, within the volume and deviation targets.
+void expect_exact(const Outcome& o, const std::string& tag) {
+    expect_solid(o, tag);
+    for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << tag << ": " << f.reason;
+    expect_near_the_part(o, tag);
+}
+
 TEST(ReverseSurfaces, EverySamplePartFromStlFineAndCoarse) {
     int cases = 0, count_right = 0;
     for (const SamplePartInfo& info : sample_parts()) {
@@ -484,10 +491,8 @@ TEST(ReverseSurfaces, ABandFaceThatFailsTakesItsOwnSeam) {
     const auto path = corpus_step_dir() / "occt_screw.step";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
     const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "screw");
-    expect_solid(o, "screw");
-    for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << f.reason;
+    expect_exact(o, "screw");
     EXPECT_NEAR(o.report.solid_volume, o.true_volume, 1e-5 * o.true_volume);
-    expect_near_the_part(o, "screw");
 }
 
 // CTC 01's and CTC 05's drill points, cones cut across by a 2 mm slot: each region is a cap
@@ -499,10 +504,8 @@ TEST(ReverseSurfaces, ACapRoundAConesApexGetsASeamAndADegeneratedEdge) {
     const auto path = corpus_step_dir() / "nist_ctc_01_asme1_rd.stp";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
     const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "ctc01");
-    expect_solid(o, "ctc01");
-    for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << f.reason;
+    expect_exact(o, "ctc01");
     EXPECT_EQ(o.report.faces, o.true_faces);
-    expect_near_the_part(o, "ctc01");
 }
 
 // Where four surfaces meet, segmentation can leave two corners of three joined by a one-edge
@@ -514,9 +517,7 @@ TEST(ReverseSurfaces, CornersOfFourSurfacesAreOneVertex) {
     const auto path = corpus_step_dir() / "nist_ctc_04_asme1_rd.stp";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
     const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "ctc04");
-    expect_solid(o, "ctc04");
-    for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << f.reason;
-    expect_near_the_part(o, "ctc04");
+    expect_exact(o, "ctc04");
 }
 
 // The M6 screw's thread (~270 regions of cones, tori and planes along a helix): the face of

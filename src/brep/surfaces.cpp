@@ -1130,6 +1130,29 @@ bool clear_of_loops(const gp_Pnt2d& a, const gp_Pnt2d& b, const std::vector<Unwr
     return true;
 }
 
+// A seam edge of `face` from vertex `v0` at `p0` to `v1` at `p1` (surface parameters), straight
+// in (u, v): used forward along that segment, reversed along it shifted `shift` in u (a turn,
+// where the loop beside it has brought the wire). A null edge when it cannot be made.
+TopoDS_Edge seam_edge(const TopoDS_Face& face, const TopoDS_Vertex& v0, const gp_Pnt2d& p0,
+                      const TopoDS_Vertex& v1, const gp_Pnt2d& p1, double shift, double tolerance) {
+    const double span = p0.Distance(p1);
+    if (span <= Precision::PConfusion()) return {};
+    Handle(Geom2d_Line) forward = new Geom2d_Line(p0, gp_Dir2d(p1.XY() - p0.XY()));
+    Handle(Geom2d_Curve) backward =
+        Handle(Geom2d_Curve)::DownCast(forward->Translated(gp_Vec2d(shift, 0)));
+    BRep_Builder B;
+    TopoDS_Edge seam;
+    B.MakeEdge(seam);
+    B.UpdateEdge(seam, forward, face, tolerance);
+    B.Range(seam, 0, span);
+    B.Add(seam, v0.Oriented(TopAbs_FORWARD));
+    B.Add(seam, v1.Oriented(TopAbs_REVERSED));
+    if (!BRepLib::BuildCurve3d(seam, tolerance)) return {};
+    B.UpdateEdge(seam, forward, backward, face, tolerance);
+    B.Range(seam, 0, span);
+    return seam;
+}
+
 // The wires of a face on a cone with one loop that goes once round the axis (the face is a cap
 // round the apex: CTC 01's and CTC 05's drill points, cut across by a slot), with that loop
 // closed by a seam along the ruling from one of its vertices to the apex and a degenerated
@@ -1183,26 +1206,14 @@ std::vector<std::vector<TopoDS_Edge>> seamed_cap(const TopoDS_Face& face,
     const TopoDS_Vertex va = TopExp::FirstVertex(wires[ia][best_a], true);
     const gp_Pnt2d pa =
         revolution_uv(s, BRep_Tool::Pnt(va), loops[ia].uv[loops[ia].edge_start[best_a]]);
-    if (std::abs(pa.Y() - v_apex) <= Precision::PConfusion()) return {};
     BRep_Builder B;
     TopoDS_Vertex tip;
     B.MakeVertex(tip, s.Value(pa.X(), v_apex), tolerance);
     // The seam from the apex up the ruling to the vertex: forward from the apex, and reversed
     // a turn along, where the loop has brought the wire.
-    const gp_Pnt2d foot(pa.X(), v_apex);
-    Handle(Geom2d_Line) forward = new Geom2d_Line(foot, gp_Dir2d(0, pa.Y() > v_apex ? 1 : -1));
-    Handle(Geom2d_Curve) backward =
-        Handle(Geom2d_Curve)::DownCast(forward->Translated(gp_Vec2d(w * kTurn, 0)));
-    const double span = std::abs(pa.Y() - v_apex);
-    TopoDS_Edge seam;
-    B.MakeEdge(seam);
-    B.UpdateEdge(seam, forward, face, tolerance);
-    B.Range(seam, 0, span);
-    B.Add(seam, tip.Oriented(TopAbs_FORWARD));
-    B.Add(seam, va.Oriented(TopAbs_REVERSED));
-    if (!BRepLib::BuildCurve3d(seam, tolerance)) return {};
-    B.UpdateEdge(seam, forward, backward, face, tolerance);
-    B.Range(seam, 0, span);
+    const TopoDS_Edge seam =
+        seam_edge(face, tip, gp_Pnt2d(pa.X(), v_apex), va, pa, w * kTurn, tolerance);
+    if (seam.IsNull()) return {};
     // The apex, a turn back from where the reversed seam arrives to where the seam leaves.
     TopoDS_Edge degenerate;
     B.MakeEdge(degenerate);
@@ -1341,21 +1352,8 @@ std::vector<std::vector<TopoDS_Edge>> seamed_band(
     const TopoDS_Vertex vb = TopExp::FirstVertex(wires[ib][best_b], true);
     const gp_Pnt2d pa = revolution_uv(s, BRep_Tool::Pnt(va), best_pa);
     const gp_Pnt2d pb = revolution_uv(s, BRep_Tool::Pnt(vb), best_pb);
-    const double span = pa.Distance(pb);
-    if (span <= Precision::PConfusion()) return {};
-    Handle(Geom2d_Line) forward = new Geom2d_Line(pb, gp_Dir2d(pa.XY() - pb.XY()));
-    Handle(Geom2d_Curve) backward =
-        Handle(Geom2d_Curve)::DownCast(forward->Translated(gp_Vec2d(w * kTurn, 0)));
-    BRep_Builder B;
-    TopoDS_Edge seam;
-    B.MakeEdge(seam);
-    B.UpdateEdge(seam, forward, face, tolerance);
-    B.Range(seam, 0, span);
-    B.Add(seam, vb.Oriented(TopAbs_FORWARD));
-    B.Add(seam, va.Oriented(TopAbs_REVERSED));
-    if (!BRepLib::BuildCurve3d(seam, tolerance)) return {};
-    B.UpdateEdge(seam, forward, backward, face, tolerance);
-    B.Range(seam, 0, span);
+    const TopoDS_Edge seam = seam_edge(face, vb, pb, va, pa, w * kTurn, tolerance);
+    if (seam.IsNull()) return {};
 
     // Loop a from its vertex round to it, the seam back to b, loop b round, the seam to a.
     std::vector<TopoDS_Edge> band;
