@@ -1041,9 +1041,9 @@ struct CurveJob {
     bool ok = false, intersected = false, touched = false, analytic = false;
 };
 
-// A face's loop on a cylinder or cone, sampled in wire order: the points' surface parameters
-// (u, the angle, unwrapped to run on continuously), where each edge's samples start, and how
-// many turns about the axis the loop makes.
+// A face's loop on a cylinder, cone or torus, sampled in wire order: the points' surface
+// parameters (u, the angle, unwrapped to run on continuously; a torus's v too), where each
+// edge's samples start, and how many turns about the axis the loop makes.
 struct UnwrappedLoop {
     std::vector<gp_Pnt2d> uv;
     std::vector<std::size_t> edge_start;
@@ -1239,8 +1239,8 @@ std::vector<std::vector<TopoDS_Edge>> seamed_cap(const TopoDS_Face& face,
     return out;
 }
 
-// The wires of a face on a cylinder or cone whose loops include two that each go once round
-// the axis (the face is a band round it), with those two joined into one wire by a seam edge
+// The wires of a face on a cylinder, cone or torus whose loops include two that each go once
+// round the axis (the face is a band round it), with those two joined into one wire by a seam edge
 // between a vertex of each. OpenCASCADE's face fix adds such a seam itself along one ruling,
 // but only right when each loop crosses that ruling once: the M6 screw's thread root, a
 // cylinder band whose outer loop winds down the thread, crossed the ruling at every turn and
@@ -1307,9 +1307,6 @@ std::vector<std::vector<TopoDS_Edge>> seamed_band(
         }
     }
     const int copies = static_cast<int>(std::ceil((u_hi - u_lo) / kTurn)) + 1;
-    const auto clear = [&](const gp_Pnt2d& a, const gp_Pnt2d& b) {
-        return clear_of_loops(a, b, loops, copies);
-    };
     // The segment's length on the surface, from a few points along it.
     const auto length = [&](const gp_Pnt2d& a, const gp_Pnt2d& b) {
         constexpr int kSteps = 8;
@@ -1323,9 +1320,16 @@ std::vector<std::vector<TopoDS_Edge>> seamed_band(
         }
         return len;
     };
-    double best = 1e300;
-    std::size_t best_a = 0, best_b = 0;
-    gp_Pnt2d best_pa, best_pb;
+    // Every pair of vertices (b's a turn either way), shortest first; the first clear one is
+    // taken. Testing a pair against every loop costs as much as the loops' samples, so only as
+    // many are tested as it takes (a band beside a fallback has a loop of hundreds of mesh-edge
+    // segments: every pair tested would be cubic in them).
+    struct Candidate {
+        double length;
+        std::size_t a, b;
+        gp_Pnt2d pa, pb;
+    };
+    std::vector<Candidate> candidates;
     for (std::size_t ea = 0; ea < wires[ia].size(); ++ea) {
         const gp_Pnt2d pa = loops[ia].uv[loops[ia].edge_start[ea]];
         for (std::size_t eb = 0; eb < wires[ib].size(); ++eb) {
@@ -1334,17 +1338,18 @@ std::vector<std::vector<TopoDS_Edge>> seamed_band(
                 // b's point taken the nearest turn to a's, then a turn either way.
                 const double shift = kTurn * (std::round((pa.X() - b0.X()) / kTurn) + k);
                 const gp_Pnt2d pb(b0.X() + shift, b0.Y());
-                const double len = length(pa, pb);
-                if (len >= best || !clear(pa, pb)) continue;
-                best = len;
-                best_a = ea;
-                best_b = eb;
-                best_pa = pa;
-                best_pb = pb;
+                candidates.push_back({length(pa, pb), ea, eb, pa, pb});
             }
         }
     }
-    if (best == 1e300) return {};
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const Candidate& x, const Candidate& y) { return x.length < y.length; });
+    const auto best = std::find_if(candidates.begin(), candidates.end(), [&](const Candidate& c) {
+        return clear_of_loops(c.pa, c.pb, loops, copies);
+    });
+    if (best == candidates.end()) return {};
+    const std::size_t best_a = best->a, best_b = best->b;
+    const gp_Pnt2d best_pa = best->pa, best_pb = best->pb;
 
     // The seam from b's vertex to a's; used forward (b to a) on the pcurve through those
     // points, and reversed (a to b) a turn along, where loop a has brought the wire.
@@ -1450,9 +1455,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     std::vector<std::int32_t> absorbed(nr, -1);
     // Regions whose tangent junctions take piecewise-linear edges (after a self-crossing wire).
     std::vector<std::uint8_t> linear(nr, 0);
-    // Regions whose face is a band round a cylinder's or cone's axis, or a cap round a cone's
-    // apex (seamed_band), and those of them whose face takes its own seam after it failed with
-    // the fix's.
+    // Regions whose face is a band round a cylinder's, cone's or torus's axis, or a cap round
+    // a cone's apex or a spindle torus's axis point (seamed_band), and those of them whose face
+    // takes its own seam after it failed with the fix's.
     std::vector<std::uint8_t> is_band_face(nr, 0), own_seam(nr, 0);
     // Corners (mesh vertex ids) solved without it after a face or chain at them failed with it
     // (a corner moved along a coarse mesh's contact band can pass its chain's next point).
