@@ -351,6 +351,17 @@ bool chord_fits(const Context& c, const Surface& s, std::uint32_t f) {
     return mid <= std::max(kMiddleSagFactor * c.sag, chord_sag(s, len, p));
 }
 
+/// Facet f's smallest height: twice its area over its longest side.
+double narrowest_width(const Context& c, std::uint32_t f) {
+    double longest = 0;
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 a = c.m.position(c.m.vertex(fid(f), i));
+        const Vec3 b = c.m.position(c.m.vertex(fid(f), (i + 1) % 3));
+        longest = std::max(longest, norm(b - a));
+    }
+    return longest > 0 ? 2 * c.fd.area[f] / longest : 0;
+}
+
 /// Whether an edge between two of `faces` is sharp.
 bool sharp_inside(const Context& c, std::span<const std::uint32_t> faces) {
     std::vector<std::uint32_t> sorted(faces.begin(), faces.end());
@@ -1373,24 +1384,41 @@ std::uint64_t absorb_small_regions(Context& c, std::vector<Draft>& drafts) {
                 }
                 std::uint32_t best = kNone;
                 double best_cost = c.tol;
-                for (const std::uint32_t g : c.fd.adj[f]) {
-                    if (g == kNone) continue;
+                // The neighbour across edge i, when the facet may join it that way: not across
+                // a sharp edge unless the facet's normal agrees with the neighbour's surface, if
+                // the facet is wider than the deflection (a narrower one's normal says nothing:
+                // CTC 05's fan slivers on a fillet, 0.6 x the deflection wide). A coarse bore's
+                // end cap (an octagon in six triangles, OCCT's TR12J housing) has its four ear
+                // triangles' corners on the bore and their middles within twice the deflection;
+                // they joined the bore across its rim (1.9 x the deflection wide), and the two
+                // triangles left of the cap got no edge with it (20 caps, 20 fallbacks).
+                const bool wide = narrowest_width(c, f) > c.sag;
+                const auto joinable = [&](std::size_t i) -> std::uint32_t {
+                    const std::uint32_t g = c.fd.adj[f][i];
+                    if (g == kNone) return kNone;
                     const std::uint32_t other = region[g];
-                    if (other == r || other == kNone || drafts[other].surface_index >= 0) continue;
-                    // No normal test: the neighbour's surface is established, and the leftovers
-                    // are often slivers, whose normals say nothing (see chords_agree()).
+                    if (other == r || other == kNone || drafts[other].surface_index >= 0)
+                        return kNone;
+                    if (wide && c.sharp_edge[3 * f + static_cast<std::uint32_t>(i)] &&
+                        !normal_agrees(c, drafts[other].surface, f))
+                        return kNone;
+                    return other;
+                };
+                for (std::size_t i = 0; i < 3; ++i) {
+                    const std::uint32_t other = joinable(i);
+                    if (other == kNone) continue;
+                    // No normal test across a smooth edge: the neighbour's surface is
+                    // established, and the leftovers are often slivers, whose normals say
+                    // nothing (see chords_agree()).
                     const double cost = facet_cost(c, drafts[other].surface, f, false);
                     if (cost <= best_cost) best_cost = cost, best = other;
                 }
                 // No neighbour takes it as a chord of the deflection: one whose surface has
                 // the facet's corners and whose middle sags no more than a chord of its length
                 // across that surface can (chord_fits()).
-                for (const std::uint32_t g : c.fd.adj[f]) {
-                    if (best != kNone) break;
-                    if (g == kNone) continue;
-                    const std::uint32_t other = region[g];
-                    if (other == r || other == kNone || drafts[other].surface_index >= 0) continue;
-                    if (chord_fits(c, drafts[other].surface, f)) best = other;
+                for (std::size_t i = 0; i < 3 && best == kNone; ++i) {
+                    const std::uint32_t other = joinable(i);
+                    if (other != kNone && chord_fits(c, drafts[other].surface, f)) best = other;
                 }
                 if (best == kNone) {
                     kept.push_back(f);
