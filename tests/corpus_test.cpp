@@ -5,7 +5,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <numbers>
+#include <set>
+#include <sstream>
+#include <string>
 
 #include "ncrev/io.h"
 #include "ncrev/mesh.h"
@@ -98,6 +103,54 @@ TEST(Corpus, CoarseBoreCapsStayOffTheBore) {
     }
     EXPECT_GE(cylinders, 100u);
     EXPECT_EQ(facing_along, 0u);
+}
+
+// NIST FTC 08 as a CAD system tessellated it (AP242, 3368 facets; labels.csv gives each
+// triangle's true face): its fillets, 3.048 mm in radius, come in six slivers from rim to rim,
+// every vertex on the cylinder. Each sliver was a plane of its own: a lone facet's next ring
+// takes in the neighbouring faces' facets too, and no surface fits them all. Growing now takes
+// the facets parallel to the seed's long edge one at a time while a cylinder or cone takes them
+// along its generators (108 -> 113 of 159 cylindrical faces whole, 406 -> 381 regions).
+TEST(Corpus, CoarseFilletStripsAreCylinders) {
+    const auto path = corpus_stl_dir() / "nist_ftc_08_asme1_ap242-e1-tg.stl";
+    const auto labels = corpus_stl_dir() / "nist_ftc_08_asme1_ap242-e1-tg.labels.csv";
+    if (!std::filesystem::exists(path) || !std::filesystem::exists(labels))
+        GTEST_SKIP() << "no corpus file " << path;
+    const TriangleSoup soup = read_mesh_file(path).value();
+    const std::size_t facets = soup.triangles.size();
+    const Mesh mesh = build_mesh(soup).value().mesh;
+    const SegmentResult sr = segment(mesh).value();
+    const std::vector<std::int32_t> region = input_labels(mesh, sr, facets);
+    // triangle,face_index,step_face_id,surface_type
+    std::ifstream in(labels);
+    std::string line;
+    std::getline(in, line);
+    std::map<std::string, std::set<std::int32_t>> regions_of;  // cylindrical true faces
+    while (std::getline(in, line)) {
+        std::stringstream row(line);
+        std::string triangle, face, id, type;
+        std::getline(row, triangle, ',');
+        std::getline(row, face, ',');
+        std::getline(row, id, ',');
+        std::getline(row, type, ',');
+        if (type != "CYLINDRICAL_SURFACE") continue;
+        regions_of[face].insert(region.at(std::stoul(triangle)));
+    }
+    ASSERT_EQ(regions_of.size(), 159u);
+    std::size_t whole = 0;
+    for (const auto& [face, rs] : regions_of) {
+        if (rs.size() != 1 || *rs.begin() < 0) continue;
+        const Surface& s = sr.regions[static_cast<std::size_t>(*rs.begin())].fit.surface;
+        whole += s.kind == FitKind::kCylinder;
+    }
+    EXPECT_GE(whole, 113u);
+    EXPECT_LE(sr.regions.size(), 381u);
+    // True face 6: a fillet 151 mm long in six slivers (triangles 1163-1168).
+    const std::set<std::int32_t>& six = regions_of.at("6");
+    ASSERT_EQ(six.size(), 1u);
+    const Surface& fillet = sr.regions[static_cast<std::size_t>(*six.begin())].fit.surface;
+    EXPECT_EQ(fillet.kind, FitKind::kCylinder);
+    EXPECT_NEAR(fillet.radius, 3.048, 0.01);
 }
 
 }  // namespace
