@@ -1843,18 +1843,54 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
             });
         }
         const auto in_strip = [&](std::uint32_t r) { return along[r] != 0; };
-        for (const std::uint32_t t : comp) {
-            if (!along[t] || chained[t]) continue;
-            std::vector<std::uint32_t> group = component(t, in_strip, chained);
-            if (group.size() < kFreeformMinPieces) continue;
+        // One strip's pieces in a row (a ring's too), by walking from one with the fewest strip
+        // neighbours to the lowest-numbered unvisited neighbour; pieces off that walk (a branch)
+        // are left for a row of their own.
+        const auto in_a_row = [&](const std::vector<std::uint32_t>& group) {
+            std::vector<std::uint32_t> row;
+            std::vector<std::uint32_t> sorted = group;
+            std::sort(sorted.begin(), sorted.end());
+            const auto in_group = [&](std::uint32_t r) {
+                return std::binary_search(sorted.begin(), sorted.end(), r);
+            };
+            const auto degree = [&](std::uint32_t r) {
+                return std::count_if(nbrs[r].begin(), nbrs[r].end(), in_group);
+            };
+            std::uint32_t at = *std::min_element(sorted.begin(), sorted.end(),
+                                                 [&](std::uint32_t a, std::uint32_t b) {
+                                                     const auto da = degree(a), db = degree(b);
+                                                     return da != db ? da < db : a < b;
+                                                 });
+            std::vector<std::uint8_t> walked(sorted.size(), 0);
+            for (;;) {
+                row.push_back(at);
+                walked[static_cast<std::size_t>(std::lower_bound(sorted.begin(), sorted.end(), at) -
+                                                sorted.begin())] = 1;
+                std::uint32_t next = kNone;
+                for (const std::uint32_t n : nbrs[at]) {
+                    if (!in_group(n)) continue;
+                    const auto k = static_cast<std::size_t>(
+                        std::lower_bound(sorted.begin(), sorted.end(), n) - sorted.begin());
+                    if (!walked[k]) next = std::min(next, n);
+                }
+                if (next == kNone) break;
+                at = next;
+            }
+            return row;
+        };
+        // A run of the row as one region, when one B-spline takes it (see above); a run it does
+        // not take in halves, each from kFreeformMinPieces pieces on: a closed wall round a boss
+        // (trimesh's idler riser, 143 one-facet planes in a ring) is no height field whole.
+        const auto take = [&](std::span<const std::uint32_t> run) {
             std::vector<std::uint32_t> faces;
             Pieces whole;
-            for (const std::uint32_t p : group) {
+            for (const std::uint32_t p : run) {
                 faces.insert(faces.end(), drafts[p].faces.begin(), drafts[p].faces.end());
                 whole.parameters += free_parameters(fitted[p].fit.surface);
             }
             FitResult r = fit_group(c, faces, whole);
-            if (!r.ok || !chords_agree(c, r.surface, faces)) continue;
+            if (!r.ok || !chords_agree(c, r.surface, faces)) return false;
+            std::vector<std::uint32_t> group(run.begin(), run.end());
             std::sort(group.begin(), group.end());
             std::sort(faces.begin(), faces.end());
             drafts[group.front()].faces = std::move(faces);
@@ -1866,6 +1902,27 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
                 drafts[p].faces.clear();
             }
             merged.push_back(group.front());
+            return true;
+        };
+        const auto take_runs = [&](const auto& self, std::span<const std::uint32_t> run) -> void {
+            if (run.size() < kFreeformMinPieces || take(run)) return;
+            if (run.size() < 2 * kFreeformMinPieces) return;
+            const std::size_t half = run.size() / 2;
+            self(self, run.first(half));
+            self(self, run.subspan(half));
+        };
+        for (const std::uint32_t t : comp) {
+            if (!along[t] || chained[t]) continue;
+            std::vector<std::uint32_t> group = component(t, in_strip, chained);
+            if (group.size() < kFreeformMinPieces) continue;
+            while (!group.empty()) {
+                const std::vector<std::uint32_t> row = in_a_row(group);
+                take_runs(take_runs, row);
+                std::vector<std::uint32_t> rest;
+                for (const std::uint32_t p : group)
+                    if (std::find(row.begin(), row.end(), p) == row.end()) rest.push_back(p);
+                group = std::move(rest);
+            }
         }
     }
     return merged;
