@@ -528,7 +528,9 @@ TEST(ReverseSurfaces, CornersOfFourSurfacesAreOneVertex) {
 // band whose outer loop winds down the thread round the axis nine times, then still fell back
 // as its 717 facets: the fix's own seam, one ruling from the top loop down to the first
 // crossing, cut off a sliver. seamed_band() joins the band's two loops by a seam of its own
-// between them: 797 -> 81 faces, no fallback.
+// between them: 797 -> 81 faces, no fallback. Lone facets whose rings no surface took whole
+// now grow by a greedy pick from their rings that keeps generators (strip_fit(), the second
+// try): 81 -> 64 faces (34 -> 20 planes), volume 0.98 -> 0.58 % off.
 TEST(ReverseSurfaces, AThreadedScrewIsNotBuiltWhollyPlanar) {
     const auto path = corpus_step_dir() / "build123d_M6-1x12-countersunk-screw.step";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus at " << path;
@@ -536,7 +538,7 @@ TEST(ReverseSurfaces, AThreadedScrewIsNotBuiltWhollyPlanar) {
     expect_solid(o, "m6_screw");
     for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << f.reason;
     EXPECT_EQ(o.report.faces_by_kind.count("facet"), 0u);
-    EXPECT_LE(o.report.faces, 90u);
+    EXPECT_LE(o.report.faces, 70u);
     ASSERT_TRUE(o.report.deviation.has_value());
     EXPECT_LE(o.report.deviation->mesh_to_solid.max, 2 * o.deflection);
     EXPECT_LE(o.report.deviation->solid_to_mesh.max, 2 * o.deflection);

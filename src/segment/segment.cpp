@@ -367,16 +367,15 @@ double narrowest_width(const Context& c, std::uint32_t f) {
 }
 
 /// Whether facet f has an edge along a generator of s (a cylinder or a cone): its middle on s
-/// within the chordal deflection though a chord of that length across s would sag four times
-/// as much.
-bool has_generator(const Context& c, const Surface& s, std::uint32_t f) {
+/// within `near` though a chord of that length across s would sag four times as much.
+bool has_generator(const Context& c, const Surface& s, std::uint32_t f, double near) {
     for (int i = 0; i < 3; ++i) {
         const Vec3 a = c.m.position(c.m.vertex(fid(f), i));
         const Vec3 b = c.m.position(c.m.vertex(fid(f), (i + 1) % 3));
         const Vec3 mid = (a + b) / 2.0;
-        if (distance(s, mid) > c.sag) continue;
+        if (distance(s, mid) > near) continue;
         const std::array<Vec3, 3> p{a, b, mid};
-        if (chord_sag(s, norm(b - a), p) > 4 * c.sag) return true;
+        if (chord_sag(s, norm(b - a), p) > 4 * near) return true;
     }
     return false;
 }
@@ -543,14 +542,15 @@ std::optional<FitKind> settled(const Draft& d) {
 
 /// A lone facet's strip of a coarsely meshed cylinder or cone (a CAD system's tessellation:
 /// facets from rim to rim, NIST FTC 08's 3368-facet mesh has fillets in six such slivers, each
-/// a plane of its own): the facets among `trial` that have an edge parallel to the seed's
-/// longest within kStripParallel, taken one at a time while `fit` takes them all and each has
-/// an edge along a generator of the surface (has_generator()). Returns the surface and the
-/// faces (the region's, then those taken), or nothing when no facet is taken.
+/// a plane of its own): the facets among `trial` after its first `fixed` (taken whole) that
+/// have an edge parallel to the seed's longest within kStripParallel (with `fixed` the
+/// region's own facets only), taken one at a time while `fit` takes them all and each has an
+/// edge along a generator of the surface (has_generator(), within `near`). Returns the surface
+/// and the faces taken, or nothing when no facet is taken.
 template <class Fit>
 std::optional<std::pair<FitResult, std::vector<std::uint32_t>>> strip_fit(
     const Context& c, std::span<const std::uint32_t> faces, std::span<const std::uint32_t> trial,
-    const Fit& fit) {
+    std::size_t fixed, double near, const Fit& fit) {
     const std::uint32_t seed = faces.front();
     Vec3 dir{0, 0, 0};
     for (int i = 0; i < 3; ++i) {
@@ -560,7 +560,9 @@ std::optional<std::pair<FitResult, std::vector<std::uint32_t>>> strip_fit(
     }
     if (norm(dir) == 0) return std::nullopt;
     dir = normalized(dir);
+    const bool own = fixed == faces.size();
     const auto parallel = [&](std::uint32_t f) {
+        if (!own) return true;
         for (int i = 0; i < 3; ++i) {
             const Vec3 e =
                 c.m.position(c.m.vertex(fid(f), (i + 1) % 3)) - c.m.position(c.m.vertex(fid(f), i));
@@ -569,11 +571,12 @@ std::optional<std::pair<FitResult, std::vector<std::uint32_t>>> strip_fit(
         }
         return false;
     };
-    std::vector<std::uint32_t> taken(faces.begin(), faces.end());
+    std::vector<std::uint32_t> taken(trial.begin(),
+                                     trial.begin() + static_cast<std::ptrdiff_t>(fixed));
     std::optional<FitResult> best;
     std::vector<std::uint32_t> best_faces;
     std::vector<VertexId> points;
-    for (std::size_t i = faces.size(); i < trial.size(); ++i) {
+    for (std::size_t i = fixed; i < trial.size(); ++i) {
         const std::uint32_t f = trial[i];
         if (!parallel(f)) continue;
         taken.push_back(f);
@@ -582,11 +585,12 @@ std::optional<std::pair<FitResult, std::vector<std::uint32_t>>> strip_fit(
             for (int k = 0; k < 3; ++k) points.push_back(c.m.vertex(fid(g), k));
         std::sort(points.begin(), points.end());
         points.erase(std::unique(points.begin(), points.end()), points.end());
-        if (points.size() < kMinVertices[static_cast<int>(FitKind::kCylinder)]) continue;
+        // Too few points for a cylinder yet: taken on trust only along the seed's own strip.
+        if (own && points.size() < kMinVertices[static_cast<int>(FitKind::kCylinder)]) continue;
         auto r = fit(taken);
         bool ok = r && (r->surface.kind == FitKind::kCylinder || r->surface.kind == FitKind::kCone);
         for (std::size_t k = 0; ok && k < taken.size(); ++k)
-            ok = has_generator(c, r->surface, taken[k]);
+            ok = has_generator(c, r->surface, taken[k], near);
         if (!ok) {
             taken.pop_back();
             continue;
@@ -718,7 +722,9 @@ std::vector<Draft> grow_patch(Context& c, const std::vector<std::uint32_t>& patc
                 }
                 if (trial.size() > first) r = ring_fit(trial);
                 if (!r && d.faces.size() <= kLooseFacets && trial.size() > first) {
-                    if (auto g = strip_fit(c, d.faces, trial, ring_fit)) {
+                    auto g = strip_fit(c, d.faces, trial, d.faces.size(), c.sag, ring_fit);
+                    if (!g) g = strip_fit(c, d.faces, trial, first, c.tol, ring_fit);
+                    if (g) {
                         r = std::move(g->first);
                         for (std::size_t i = d.faces.size(); i < trial.size(); ++i)
                             if (std::find(g->second.begin(), g->second.end(), trial[i]) ==
