@@ -580,13 +580,15 @@ std::optional<std::pair<FitResult, std::vector<std::uint32_t>>> strip_fit(
         const std::uint32_t f = trial[i];
         if (!parallel(f)) continue;
         taken.push_back(f);
-        points.clear();
-        for (const std::uint32_t g : taken)
-            for (int k = 0; k < 3; ++k) points.push_back(c.m.vertex(fid(g), k));
-        std::sort(points.begin(), points.end());
-        points.erase(std::unique(points.begin(), points.end()), points.end());
         // Too few points for a cylinder yet: taken on trust only along the seed's own strip.
-        if (own && points.size() < kMinVertices[static_cast<int>(FitKind::kCylinder)]) continue;
+        if (own) {
+            points.clear();
+            for (const std::uint32_t g : taken)
+                for (int k = 0; k < 3; ++k) points.push_back(c.m.vertex(fid(g), k));
+            std::sort(points.begin(), points.end());
+            points.erase(std::unique(points.begin(), points.end()), points.end());
+            if (points.size() < kMinVertices[static_cast<int>(FitKind::kCylinder)]) continue;
+        }
         auto r = fit(taken);
         bool ok = r && (r->surface.kind == FitKind::kCylinder || r->surface.kind == FitKind::kCone);
         for (std::size_t k = 0; ok && k < taken.size(); ++k)
@@ -1485,19 +1487,18 @@ std::uint64_t absorb_small_regions(Context& c, std::vector<Draft>& drafts) {
                 // they joined the bore across its rim (1.9 x the deflection wide), and the two
                 // triangles left of the cap got no edge with it (20 caps, 20 fallbacks).
                 const bool wide = narrowest_width(c, f) > c.sag;
-                const auto joinable = [&](std::size_t i) -> std::uint32_t {
+                std::array<std::uint32_t, 3> joinable{kNone, kNone, kNone};
+                for (std::size_t i = 0; i < 3; ++i) {
                     const std::uint32_t g = c.fd.adj[f][i];
-                    if (g == kNone) return kNone;
+                    if (g == kNone) continue;
                     const std::uint32_t other = region[g];
-                    if (other == r || other == kNone || drafts[other].surface_index >= 0)
-                        return kNone;
+                    if (other == r || other == kNone || drafts[other].surface_index >= 0) continue;
                     if (wide && c.sharp_edge[3 * f + static_cast<std::uint32_t>(i)] &&
                         !normal_agrees(c, drafts[other].surface, f))
-                        return kNone;
-                    return other;
-                };
-                for (std::size_t i = 0; i < 3; ++i) {
-                    const std::uint32_t other = joinable(i);
+                        continue;
+                    joinable[i] = other;
+                }
+                for (const std::uint32_t other : joinable) {
                     if (other == kNone) continue;
                     // No normal test across a smooth edge: the neighbour's surface is
                     // established, and the leftovers are often slivers, whose normals say
@@ -1508,8 +1509,8 @@ std::uint64_t absorb_small_regions(Context& c, std::vector<Draft>& drafts) {
                 // No neighbour takes it as a chord of the deflection: one whose surface has
                 // the facet's corners and whose middle sags no more than a chord of its length
                 // across that surface can (chord_fits()).
-                for (std::size_t i = 0; i < 3 && best == kNone; ++i) {
-                    const std::uint32_t other = joinable(i);
+                for (const std::uint32_t other : joinable) {
+                    if (best != kNone) break;
                     if (other != kNone && chord_fits(c, drafts[other].surface, f)) best = other;
                 }
                 if (best == kNone) {
