@@ -173,5 +173,39 @@ TEST(Corpus, ARingOfSliversBecomesAFewExtrudedFaces) {
     EXPECT_LE(r.deviation->mesh_to_solid.max, r.chordal_deflection);
 }
 
+// trimesh's angle block (704 facets, inches) was made by booleans on faceted solids: the rim
+// of its slanted bore (radius 0.25, 36 sides) has its vertices on the cutting solid's facets,
+// up to 8e-4 in inside the bore, four times the tolerance (2.1e-4) though well within the
+// mesh's sag (2e-3). No analytic kind took the bore within the tolerance; it was a B-spline
+// whose face self-intersected and came back as 95 facets (121 faces, 2 fallbacks). A cylinder
+// that holds the vertices as closely as that B-spline is the region's surface instead
+// (analytic_instead(), docs/segmentation.md): 26 faces, all planes and cylinders.
+TEST(Corpus, ABooleanMadeBoreIsOneCylinder) {
+    const auto path = corpus_stl_dir() / "trimesh_angle_block.stl";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    const Mesh mesh = build_mesh(read_mesh_file(path).value()).value().mesh;
+    const SegmentResult sr = segment(mesh).value();
+    std::size_t bores = 0;
+    for (const Region& g : sr.regions) {
+        const Surface& s = g.fit.surface;
+        if (s.kind != FitKind::kCylinder || std::abs(s.radius - 0.25) > 0.002) continue;
+        ++bores;
+        EXPECT_GE(g.facets, 100u);
+        EXPECT_TRUE(g.within_tolerance);
+    }
+    EXPECT_EQ(bores, 1u);
+    const auto out = std::filesystem::temp_directory_path() / "ncrev_angle_block.step";
+    const ReverseReport r = reverse_to_step(mesh, out).value();
+    std::filesystem::remove(out);
+    EXPECT_TRUE(r.solid && r.valid && r.written);
+    EXPECT_LE(r.faces, 26u);
+    EXPECT_TRUE(r.fallbacks.empty());
+    EXPECT_FALSE(r.faces_by_kind.contains("bspline"));
+    EXPECT_FALSE(r.faces_by_kind.contains("facet"));
+    ASSERT_TRUE(r.deviation.has_value());
+    EXPECT_LE(r.deviation->mesh_to_solid.max, r.chordal_deflection);
+    EXPECT_LE(r.deviation->solid_to_mesh.max, r.chordal_deflection);
+}
+
 }  // namespace
 }  // namespace ncrev
