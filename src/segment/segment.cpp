@@ -1219,6 +1219,8 @@ bool extrusion_pays(const FitResult& r, const Pieces& whole) {
 /// quantile of the curved edges' sags). A faceted cut's chord vertices lie at up to a quarter of
 /// the estimate (crossed 12- to 120-sided bores: faceted_cut_test.cpp), the angle block's 0.4.
 double chord_depth(const Context& c) { return c.sag / kSagFactor; }
+/// A triangle's middle sags 4/3 as much as its edges' middles on a sphere (see kMiddleSagFactor).
+constexpr double kChordMiddleFactor = 4.0 / 3.0;
 
 /// A fit of a cylinder, cone or sphere to the vertices of `faces` that may lie inside it by up
 /// to chord_depth(): the vertices more than the tolerance inside are left out of the
@@ -1231,6 +1233,9 @@ struct ChordFit {
     FitResult fit;
     double kept = 0;
     double inside = 0;
+    /// How deep a vertex on a chord of it may lie: as deep as its own facets' chords go (the
+    /// tessellation's sag on this surface), else chord_depth().
+    double reach = 0;
 };
 std::optional<ChordFit> chord_fit(Context& c, FitKind kind, std::span<const std::uint32_t> faces) {
     if (kind != FitKind::kCylinder && kind != FitKind::kCone && kind != FitKind::kSphere)
@@ -1266,6 +1271,21 @@ std::optional<ChordFit> chord_fit(Context& c, FitKind kind, std::span<const std:
         else
             out.kept = std::max(out.kept, std::fabs(d));
     }
+    // The reach: how deep this surface's own chords go, from the facets whose corners it keeps
+    // (their edges' middles; a triangle's middle sags up to kChordMiddleFactor x as much).
+    double own = 0;
+    for (const std::uint32_t f : faces) {
+        Vec3 p[3];
+        bool on = true;
+        for (int i = 0; i < 3; ++i) {
+            p[i] = c.m.position(c.m.vertex(fid(f), i));
+            on = on && signed_distance(r.surface, p[i]) >= -c.tol;
+        }
+        if (!on) continue;
+        for (int i = 0; i < 3; ++i)
+            own = std::max(own, -signed_distance(r.surface, 0.5 * (p[i] + p[(i + 1) % 3])));
+    }
+    out.reach = own > c.tol ? std::min(c.sag, kChordMiddleFactor * own) : chord_depth(c);
     return out;
 }
 
@@ -1297,7 +1317,7 @@ std::optional<Analytic> analytic_instead(Context& c, const FitResult& bspline,
     // the B-spline.
     for (const FitKind kind : kKindOrder) {
         const std::optional<ChordFit> cf = chord_fit(c, kind, faces);
-        if (cf && cf->kept <= bar && cf->inside <= chord_depth(c) &&
+        if (cf && cf->kept <= bar && cf->inside <= cf->reach &&
             chords_agree(c, cf->fit.surface, faces))
             return Analytic{cf->fit, std::max(bar, c.tol)};
     }
@@ -1719,7 +1739,7 @@ Region final_region(Context& c, const Draft& d, std::span<const SurfaceRecord> r
         // Its kind refitted, the vertices on chords left out (chord_fit()), as closely as it was
         // held; else to them all within the sag; else the surface as it was.
         const std::optional<ChordFit> chords = chord_fit(c, d.surface.kind, d.faces);
-        if (chords && chords->kept <= d.loose && chords->inside <= chord_depth(c)) {
+        if (chords && chords->kept <= d.loose && chords->inside <= chords->reach) {
             out.fit = chords->fit;
         } else {
             out.fit = fit(d.surface.kind, in);
@@ -2080,9 +2100,11 @@ std::vector<std::uint32_t> merge_chords(Context& c, std::vector<Draft>& drafts) 
         std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> queue;
         for (auto [a, b] : adjacent_pairs(c, region, false)) {
             if (!open(a) || !open(b)) continue;
-            if (!curved(a)) std::swap(a, b);
-            if (!curved(a) || (curved(b) && drafts[a].surface.kind != drafts[b].surface.kind))
-                continue;
+            // Of two curved ones, the larger one's kind (a ball's pieces by a crossing bore
+            // fit cylinders of their own within the tolerance).
+            if (!curved(a) || (curved(b) && drafts[b].faces.size() > drafts[a].faces.size()))
+                std::swap(a, b);
+            if (!curved(a)) continue;
             const double cost = unlikeness(c, drafts[a], drafts[b]);
             if (cost <= c.sag) queue.emplace_back(cost, a, b);
         }
@@ -2097,7 +2119,7 @@ std::vector<std::uint32_t> merge_chords(Context& c, std::vector<Draft>& drafts) 
             // Only a union that vertices on chords keep apart: one the merging refused for
             // other reasons stays refused (a cone of 5 facets took two one-facet planes of
             // the AP242 FTC 08 mesh, and its solid lost 0.1 % of its volume).
-            if (!cf || cf->inside == 0 || cf->kept > bar || cf->inside > chord_depth(c) ||
+            if (!cf || cf->inside == 0 || cf->kept > bar || cf->inside > cf->reach ||
                 !chords_agree(c, cf->fit.surface, both))
                 continue;
             const bool keep_a = drafts[a].faces.size() >= drafts[b].faces.size() ||
@@ -2145,15 +2167,16 @@ std::vector<std::uint32_t> grow_loose(Context& c, std::vector<Draft>& drafts) {
             nbrs.erase(std::unique(nbrs.begin(), nbrs.end()), nbrs.end());
             for (const std::uint32_t n : nbrs) {
                 const Draft& e = drafts[n];
-                if (!e.alive || e.surface_index >= 0 || e.surface.kind == FitKind::kBSpline)
-                    continue;
+                // (A free-form piece too: a bit of a faceted ball beside a crossing bore, 22
+                // facets, fits a sphere of its own only 1.2 x as loosely as its B-spline.)
+                if (!e.alive || e.surface_index >= 0) continue;
                 std::vector<std::uint32_t> both = d.faces;
                 both.insert(both.end(), e.faces.begin(), e.faces.end());
                 // As closely as the region was held, but for vertices on chords; or as the
                 // surface that replaced the B-spline did (analytic_instead()).
                 FitResult r;
                 if (const auto cf = chord_fit(c, d.surface.kind, both);
-                    cf && cf->kept <= d.loose && cf->inside <= chord_depth(c)) {
+                    cf && cf->kept <= d.loose && cf->inside <= cf->reach) {
                     r = cf->fit;
                 } else {
                     PointSet bs;
