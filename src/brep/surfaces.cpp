@@ -69,6 +69,7 @@
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Edge.hxx>
+#include <TopoDS_Iterator.hxx>
 #include <TopoDS_Shell.hxx>
 #include <TopoDS_Solid.hxx>
 #include <TopoDS_Vertex.hxx>
@@ -1377,6 +1378,45 @@ std::vector<std::vector<TopoDS_Edge>> seamed_band(
     return out;
 }
 
+// A face's wire as it walks: OpenCASCADE's ShapeBuild_ReShape::Apply puts the pieces an
+// earlier face's fix split a shared edge into in that edge's own order, each reversed, where
+// this face uses the edge reversed, so the wire runs back along them. Our fix does not reorder
+// (it would reorder seams), and BRepCheck finds the wire NotClosed: a 12-sided faceted cross
+// bore's band, whose closed edge round the vertical bore that bore's face had split in three.
+// Each such run is put back in the order the wire walks it. `edges` unchanged where the wire
+// walks already, or breaks somewhere no reversed run mends.
+std::vector<TopoDS_Edge> in_walk_order(const std::vector<TopoDS_Edge>& edges) {
+    const std::size_t n = edges.size();
+    const auto joins = [](const TopoDS_Edge& a, const TopoDS_Edge& b) {
+        return TopExp::LastVertex(a, true).IsSame(TopExp::FirstVertex(b, true));
+    };
+    std::vector<TopoDS_Edge> es = edges;
+    for (std::size_t pass = 0; pass < n; ++pass) {
+        std::size_t broken = n;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!joins(es[i], es[(i + 1) % n])) {
+                broken = i;
+                break;
+            }
+        }
+        if (broken == n) return es;
+        // The edge before the break last: the run to reverse starts the list.
+        std::rotate(es.begin(), es.begin() + static_cast<std::ptrdiff_t>((broken + 1) % n),
+                    es.end());
+        bool mended = false;
+        for (std::size_t len = 2; len < n && !mended; ++len) {
+            bool walks = joins(es[n - 1], es[len - 1]) && joins(es[0], es[len]);
+            for (std::size_t k = 0; walks && k + 1 < len; ++k) walks = joins(es[k + 1], es[k]);
+            if (walks) {
+                std::reverse(es.begin(), es.begin() + static_cast<std::ptrdiff_t>(len));
+                mended = true;
+            }
+        }
+        if (!mended) return edges;
+    }
+    return edges;
+}
+
 // The geometry one build round computed, which the next reuses while what it was computed
 // from is unchanged (build_surface_brep): a round differs from the one before only around the
 // regions that failed, and solving every corner and intersecting every pair of surfaces again
@@ -2274,6 +2314,34 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     // The edges earlier faces' fixes replaced, replaced here too: a shared
                     // edge fixed twice from its original would otherwise become two edges.
                     F = TopoDS::Face(context->Apply(F));
+                    {
+                        bool reordered = false;
+                        std::vector<std::vector<TopoDS_Edge>> walked;
+                        for (TopoDS_Iterator w(F); w.More(); w.Next()) {
+                            std::vector<TopoDS_Edge> es;
+                            for (TopoDS_Iterator e(w.Value()); e.More(); e.Next()) {
+                                es.push_back(TopoDS::Edge(e.Value()));
+                            }
+                            walked.push_back(in_walk_order(es));
+                            reordered = reordered ||
+                                        !std::equal(es.begin(), es.end(), walked.back().begin(),
+                                                    [](const TopoDS_Edge& a, const TopoDS_Edge& b) {
+                                                        return a.IsEqual(b);
+                                                    });
+                        }
+                        if (reordered) {
+                            TopoDS_Face G;
+                            B.MakeFace(G, geom[r], kMinTolerance);
+                            for (const auto& es : walked) {
+                                TopoDS_Wire W;
+                                B.MakeWire(W);
+                                for (const TopoDS_Edge& e : es) B.Add(W, e);
+                                W.Closed(true);
+                                B.Add(G, W);
+                            }
+                            F = G;
+                        }
+                    }
                     ShapeFix_Face fix(F);
                     fix.SetContext(context);
                     fix.SetPrecision(kMinTolerance);
