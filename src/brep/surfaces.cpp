@@ -1480,6 +1480,15 @@ std::vector<std::vector<TopoDS_Edge>> seamed_band(
     return out;
 }
 
+// A closed wire of `edges`, in their order, added to `face`.
+void add_wire(const BRep_Builder& B, TopoDS_Face& face, const std::vector<TopoDS_Edge>& edges) {
+    TopoDS_Wire W;
+    B.MakeWire(W);
+    for (const TopoDS_Edge& e : edges) B.Add(W, e);
+    W.Closed(true);
+    B.Add(face, W);
+}
+
 // A face's wire as it walks: OpenCASCADE's ShapeBuild_ReShape::Apply puts the pieces an
 // earlier face's fix split a shared edge into in that edge's own order, each reversed, where
 // this face uses the edge reversed, so the wire runs back along them. Our fix does not reorder
@@ -2414,13 +2423,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                         wire_edges_in = static_cast<std::size_t>(distinct.Extent());
                     }
                     is_band_face[r] = is_band ? 1 : 0;
-                    for (const auto& wire_edges : wires) {
-                        TopoDS_Wire W;
-                        B.MakeWire(W);
-                        for (const TopoDS_Edge& e : wire_edges) B.Add(W, e);
-                        W.Closed(true);
-                        B.Add(F, W);
-                    }
+                    for (const auto& wire_edges : wires) add_wire(B, F, wire_edges);
                     // The edges earlier faces' fixes replaced, replaced here too: a shared
                     // edge fixed twice from its original would otherwise become two edges.
                     F = TopoDS::Face(context->Apply(F));
@@ -2442,13 +2445,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                         if (reordered) {
                             TopoDS_Face G;
                             B.MakeFace(G, geom[r], kMinTolerance);
-                            for (const auto& es : walked) {
-                                TopoDS_Wire W;
-                                B.MakeWire(W);
-                                for (const TopoDS_Edge& e : es) B.Add(W, e);
-                                W.Closed(true);
-                                B.Add(G, W);
-                            }
+                            for (const auto& es : walked) add_wire(B, G, es);
                             F = G;
                         }
                     }
