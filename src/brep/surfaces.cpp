@@ -602,8 +602,8 @@ bool spine_junction(const Surface& a, const Surface& b, Vec3 p, double tolerance
 // contact point nearest (contact_point(), as tangency_points()) and the step along
 // the spine's direction that puts it on the others. False (and `p` unchanged) when no such
 // pair is there, or the other surfaces do not fix the point along the contact.
-bool tangent_corner(std::span<const Surface> on, double tolerance, double junction_tolerance,
-                    Vec3& p, double& tube_radius, bool& junction) {
+bool tangent_corner(std::span<const Surface> on, double tolerance, Vec3& p, double& tube_radius,
+                    bool& junction) {
     constexpr int kSteps = 20;
     const double sin_tangent = std::sin(kTangentAngle);
     junction = false;
@@ -617,18 +617,18 @@ bool tangent_corner(std::span<const Surface> on, double tolerance, double juncti
             // Two tubes meeting at a section (spine_junction()), every other surface tangent to
             // them there (the face both fillets run along): the corner is that surface's foot
             // from the junction, searched within two tube radii of p. Stepping along the
-            // contact below finds nothing there: the other surface is tangent to it too. Fitted
-            // fillets agree to `junction_tolerance` only (the fillet block's 4 mm edge fillet
-            // came 0.02 mm thin at 345k facets, twice the segmentation tolerance: its region
-            // reaches into the corner tori as far as they stay within the tolerance of it).
+            // contact below finds nothing there: the other surface is tangent to it too. Held to
+            // the tolerance: a fillet fitted thinner than that (the fillet block's 4 mm one came
+            // 0.02 mm thin at 345k facets) keeps its plain corner; allowing 10 x the tolerance
+            // moved corners of CTC 04 and FTC 07 off the mesh (mesh->solid 0.25 -> 0.69 delta).
             Vec3 s0;
             if (ti && tj && on.size() == 3 &&
-                spine_junction(on[i], on[j], p, junction_tolerance, kJunctionSpan * ri, s0)) {
+                spine_junction(on[i], on[j], p, tolerance, kJunctionSpan * ri, s0)) {
                 const Surface& third = on[3 - i - j];
                 const Vec3 q = closest_point(third, s0);
                 double residual = 0;
                 for (const Surface& s : on) residual = std::max(residual, distance(s, q));
-                if (residual <= junction_tolerance) {
+                if (residual <= tolerance) {
                     p = q;
                     tube_radius = ri;
                     junction = true;
@@ -1494,9 +1494,9 @@ void add_wire(const BRep_Builder& B, TopoDS_Face& face, const std::vector<TopoDS
 // this face uses the edge reversed, so the wire runs back along them. Our fix does not reorder
 // (it would reorder seams), and BRepCheck finds the wire NotClosed: a 12-sided faceted cross
 // bore's band, whose closed edge round the vertical bore that bore's face had split in three.
-// Each such run is put back in the order the wire walks it. `edges` unchanged where the wire
-// walks already, or breaks somewhere no reversed run mends.
-std::vector<TopoDS_Edge> in_walk_order(const std::vector<TopoDS_Edge>& edges) {
+// Each such run is put back in the order the wire walks it; true when `edges` changed (not
+// where the wire walks already, or breaks somewhere no reversed run mends).
+bool in_walk_order(std::vector<TopoDS_Edge>& edges) {
     const std::size_t n = edges.size();
     const auto joins = [](const TopoDS_Edge& a, const TopoDS_Edge& b) {
         return TopExp::LastVertex(a, true).IsSame(TopExp::FirstVertex(b, true));
@@ -1510,7 +1510,11 @@ std::vector<TopoDS_Edge> in_walk_order(const std::vector<TopoDS_Edge>& edges) {
                 break;
             }
         }
-        if (broken == n) return es;
+        if (broken == n) {
+            if (pass == 0) return false;
+            edges = std::move(es);
+            return true;
+        }
         // The edge before the break last: the run to reverse starts the list.
         std::rotate(es.begin(), es.begin() + static_cast<std::ptrdiff_t>((broken + 1) % n),
                     es.end());
@@ -1523,9 +1527,9 @@ std::vector<TopoDS_Edge> in_walk_order(const std::vector<TopoDS_Edge>& edges) {
                 mended = true;
             }
         }
-        if (!mended) return edges;
+        if (!mended) return false;
     }
-    return edges;
+    return false;
 }
 
 // The geometry one build round computed, which the next reuses while what it was computed
@@ -1852,14 +1856,14 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             // goes onto their contact curve when that is within the tolerance of every surface
             // and within the band (its half-width sqrt(2 r tol), r the tube's radius).
             // A junction of two tubes (spine_junction()) is unique within the span it was
-            // searched in: the mesh vertex may be far from it along the contact (2.6 mm at a
+            // searched in: the mesh vertex may be far from it along the contact (1.35 mm at a
             // 4 mm fillet's corner torus at a tolerance of 0.011 mm, the fillet block at 345k
             // facets, where a line and a circle of contact are tangent on the top face).
             Vec3 q = cp.point;
             double radius = 0;
             bool junction = false;
             if (contact_allowed && on.size() >= 3 &&
-                tangent_corner(on, opt.tolerance, opt.tolerance, q, radius, junction)) {
+                tangent_corner(on, opt.tolerance, q, radius, junction)) {
                 double residual = 0;
                 for (const Surface& s : on) residual = std::max(residual, distance(s, q));
                 const double band = std::sqrt(2 * radius * opt.tolerance);
@@ -1871,8 +1875,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 }
             }
             c.solved = true;
-            const double accept = opt.tolerance;
-            if (cp.residual <= accept && (c.on_contact || norm(cp.point - p) <= max_tol)) {
+            if (cp.residual <= opt.tolerance && (c.on_contact || norm(cp.point - p) <= max_tol)) {
                 p = cp.point;
                 tol = std::max(tol, 1.01 * cp.residual);
                 c.residual = cp.residual;
@@ -2435,12 +2438,8 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                             for (TopoDS_Iterator e(w.Value()); e.More(); e.Next()) {
                                 es.push_back(TopoDS::Edge(e.Value()));
                             }
-                            walked.push_back(in_walk_order(es));
-                            reordered = reordered ||
-                                        !std::equal(es.begin(), es.end(), walked.back().begin(),
-                                                    [](const TopoDS_Edge& a, const TopoDS_Edge& b) {
-                                                        return a.IsEqual(b);
-                                                    });
+                            reordered = in_walk_order(es) || reordered;
+                            walked.push_back(std::move(es));
                         }
                         if (reordered) {
                             TopoDS_Face G;
