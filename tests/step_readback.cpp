@@ -1,11 +1,11 @@
 #include "step_readback.h"
 
 #include <BRepCheck_Analyzer.hxx>
-#include <BRepGProp.hxx>
-#include <GProp_GProps.hxx>
 #include <STEPControl_Reader.hxx>
 #include <TopExp.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
+
+#include "brep/check.h"
 
 namespace ncrev::test {
 
@@ -21,9 +21,7 @@ ReadBack read_step(const std::filesystem::path& path) {
     TopExp::MapShapes(r.shape, TopAbs_FACE, faces);
     r.solids = static_cast<std::size_t>(solids.Extent());
     r.faces = static_cast<std::size_t>(faces.Extent());
-    GProp_GProps props;
-    BRepGProp::VolumeProperties(r.shape, props);
-    r.volume = props.Mass();
+    r.volume = brep_detail::solid_volume(r.shape);
     return r;
 }
 

@@ -16,6 +16,7 @@
 #include <memory>
 #include <vector>
 
+#include "brep/check.h"
 #include "brep/surfaces.h"
 #include "ncrev/io.h"
 #include "ncrev/mesh.h"
@@ -30,11 +31,7 @@ using brep_detail::RegionSurface;
 using brep_detail::SurfaceBrep;
 using brep_detail::SurfaceBrepOptions;
 
-double volume(const SurfaceBrep& b) {
-    GProp_GProps p;
-    BRepGProp::VolumeProperties(b.shape, p);
-    return p.Mass();
-}
+double volume(const SurfaceBrep& b) { return brep_detail::solid_volume(b.shape); }
 
 // The region surfaces of a segmentation (every region must have one).
 std::vector<RegionSurface> region_surfaces(const SegmentResult& sr) {

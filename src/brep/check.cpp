@@ -3,6 +3,8 @@
 #include <BRepCheck.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepCheck_Result.hxx>
+#include <BRepGProp.hxx>
+#include <GProp_GProps.hxx>
 #include <TopExp.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <cctype>
@@ -51,6 +53,12 @@ std::string check_failure(const TopoDS_Shape& shape, std::vector<TopoDS_Shape>* 
         }
     }
     return out.empty() ? "invalid" : out;
+}
+
+double solid_volume(const TopoDS_Shape& shape) {
+    GProp_GProps props;
+    BRepGProp::VolumeProperties(shape, props, kVolumeRelativeError);
+    return props.Mass();
 }
 
 }  // namespace ncrev::brep_detail

@@ -13,6 +13,7 @@
 #include <numeric>
 #include <optional>
 
+#include "brep/check.h"
 #include "brep/deviation.h"
 #include "brep/planar.h"
 #include "brep/step.h"
@@ -470,12 +471,11 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             rep.edges = static_cast<std::uint64_t>(edges.Extent());
             rep.vertices = static_cast<std::uint64_t>(vertices.Extent());
             stage("measure", [&] {
-                GProp_GProps vp, sp;
+                GProp_GProps sp;
                 BRepGProp::SurfaceProperties(brep.shape, sp);
                 rep.solid_area = sp.Mass();
                 if (brep.solid) {
-                    BRepGProp::VolumeProperties(brep.shape, vp);
-                    rep.solid_volume = vp.Mass();
+                    rep.solid_volume = brep_detail::solid_volume(brep.shape);
                     if (rep.mesh_volume != 0) {
                         rep.volume_difference =
                             (rep.solid_volume - rep.mesh_volume) / rep.mesh_volume;

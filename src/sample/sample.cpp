@@ -21,6 +21,7 @@
 #include <optional>
 #include <sstream>
 
+#include "brep/check.h"
 #include "brep/step.h"
 #include "ncrev/io.h"
 #include "sample/sample_internal.h"
@@ -195,10 +196,9 @@ std::optional<Error> build_part(const TopoDS_Shape& solid, const SampleOptions& 
                                 std::string_view description, bool require_valid,
                                 SamplePart& part) {
     SampleSolid& s = part.solid;
-    GProp_GProps vprops, sprops;
-    BRepGProp::VolumeProperties(solid, vprops);
+    GProp_GProps sprops;
     BRepGProp::SurfaceProperties(solid, sprops);
-    s.volume = vprops.Mass();
+    s.volume = brep_detail::solid_volume(solid);
     s.area = sprops.Mass();
     Bnd_Box box;
     BRepBndLib::AddOptimal(solid, box, /*useTriangulation=*/false,
