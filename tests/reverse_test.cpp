@@ -398,16 +398,6 @@ TEST(ReverseSurfaces, Deterministic) {
     EXPECT_EQ(a.step_text, b.step_text);
 }
 
-// The fillet block's top edges are rounded by 4 mm and its vertical ones by 10 mm: at each top
-// corner a torus (spine radius 6, tube 4) runs into the two edge fillets, each a cylinder of
-// the same radius whose axis touches the torus's spine circle. The corners where a fillet,
-// its torus and the face they both run along meet are where those spines touch: on the top
-// face (4, 10, 40), (10, 4, 40), ... and on the side walls (0, 10, 36), (10, 0, 36), ...
-// Solved onto the three surfaces, which are tangent to each other there, such a corner slid
-// along the contact: (4, 10, 40) stayed 1.04 mm off, about where the mesh's region borders met,
-// and the volume was 1e-5 off. spine_junction() puts it where the spines touch, within the
-// tolerance: two corners, on the fillet fitted 0.02 mm thin (its region reaches into the tori
-// as far as they stay within the tolerance of it), are 0.011-0.012 mm off, the others 1e-3.
 // The fillet block's rolling-ball corners in `o` (see the test below): each within twice the
 // tolerance of a vertex.
 void expect_rolling_ball_corners(const Outcome& o, const std::string& tag) {
@@ -438,6 +428,16 @@ void expect_rolling_ball_corners(const Outcome& o, const std::string& tag) {
     }
 }
 
+// The fillet block's top edges are rounded by 4 mm and its vertical ones by 10 mm: at each top
+// corner a torus (spine radius 6, tube 4) runs into the two edge fillets, each a cylinder of
+// the same radius whose axis touches the torus's spine circle. The corners where a fillet,
+// its torus and the face they both run along meet are where those spines touch: on the top
+// face (4, 10, 40), (10, 4, 40), ... and on the side walls (0, 10, 36), (10, 0, 36), ...
+// Solved onto the three surfaces, which are tangent to each other there, such a corner slid
+// along the contact: (4, 10, 40) stayed 1.04 mm off, about where the mesh's region borders met,
+// and the volume was 1e-5 off. spine_junction() puts it where the spines touch, within the
+// tolerance: two corners, on the fillet fitted 0.02 mm thin (its region reaches into the tori
+// as far as they stay within the tolerance of it), are 0.011-0.012 mm off, the others 1e-3.
 TEST(ReverseSurfaces, RollingBallCornersAreWhereTheSpinesTouch) {
     const SamplePart part = make("fillet_chamfer_block", kFine);
     const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "rolling_ball");
@@ -455,9 +455,9 @@ TEST(ReverseSurfaces, RollingBallCornersAreWhereTheSpinesTouch) {
 // corner torus is then the tube's section where their spines touch (tangency_points()), not the
 // mesh's border anywhere in the band where they are within the tolerance (0.7 mm), and two
 // corners solved to one point with a chain of a few mesh edges between them are one vertex.
-// At this size the volume was 5.1e-4 off before, 1.3e-5 with the refinement alone (its STL
-// from `ncrev sample`); it is 6.9e-6 off here (from the mesh in double precision; 4e-8 from
-// the float32 STL, under 1e-7), which this bound keeps.
+// At this size its STL (from `ncrev sample`) came back 5.1e-4 off in volume before, 1.3e-5 with
+// the refinement alone, as volumes were measured then (BRepGProp's default rule, before
+// 60dd34f); here, measured adaptively, it is 1.6e-7 off.
 TEST(ReverseSurfaces, AFinelyMeshedFilletBlockIsExact) {
     SampleOptions so;
     so.with_step = false;

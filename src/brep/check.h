@@ -17,7 +17,8 @@ std::string check_failure(const TopoDS_Shape& shape, std::vector<TopoDS_Shape>* 
 /// Relative error of the volumes we measure (BRepGProp's adaptive integration). Its default,
 /// a fixed Gauss rule per face, put a 15 x 14-pole B-spline top 0.24 % off (the freeform die
 /// at 159k facets: 266578 mm3 for 265937), CTC 02's reversed solid 0.023 % off and the die's
-/// own exact solid 0.003 %; adaptively all agree to 1e-6 for 0.1-0.7 s on those solids.
+/// own exact solid 0.003 % (a temporary program on the written STEP files, both ways); the
+/// bench cases pay 0.1-0.4 s for it (docs/benchmarks.md).
 constexpr double kVolumeRelativeError = 1e-7;
 
 /// The volume of `shape` (a solid, or a shape holding one) within kVolumeRelativeError.

@@ -493,6 +493,13 @@ bool contact_point(const Surface& tube, const Surface& other, Vec3 p, double tol
     return true;
 }
 
+// The direction of the spine of `s` (a cylinder or torus) at its point nearest `c`.
+Vec3 spine_direction(const Surface& s, Vec3 c) {
+    const Vec3 axis = normalized(s.axis);
+    if (s.kind == FitKind::kCylinder) return axis;
+    return normalized(cross(axis, perpendicular_part(c - s.point, axis)));
+}
+
 // Two tubes of one radius whose spines touch: an edge fillet running into the corner torus of
 // the same radius (a rolling-ball corner), a torus into a torus or into a ball. They meet along
 // the tube's section through the point `s0` where their spines touch, which is returned. Found
@@ -529,8 +536,7 @@ bool spine_junction(const Surface& a, const Surface& b, Vec3 p, double tolerance
     Vec3 c0;
     double r = 0;
     if (!spine_point(walk, p, c0, r)) return false;
-    const Vec3 axis = normalized(walk.axis);
-    const Vec3 t = normalized(cross(axis, perpendicular_part(c0 - walk.point, axis)));
+    const Vec3 t = spine_direction(walk, c0);
     const auto at = [&](double step, Vec3& x) {
         double rr = 0;
         return spine_point(walk, c0 + step * t, x, rr);
@@ -570,13 +576,6 @@ bool spine_junction(const Surface& a, const Surface& b, Vec3 p, double tolerance
         !(gap(span) > tolerance))
         return false;
     return at(best, s0);
-}
-
-// The direction of the spine of `s` (a cylinder or torus) at its point nearest `c`.
-Vec3 spine_direction(const Surface& s, Vec3 c) {
-    const Vec3 axis = normalized(s.axis);
-    if (s.kind == FitKind::kCylinder) return axis;
-    return normalized(cross(axis, perpendicular_part(c - s.point, axis)));
 }
 
 // Whether the spines of the tubes `a` and `b` (radius r) run together at their junction s0:
@@ -693,11 +692,7 @@ bool tangent_corner(std::span<const Surface> on, double tolerance, Vec3& p, doub
             for (int step = 0; step < kSteps; ++step) {
                 double radius = 0;
                 if (!contact_point(tube, other, q, tolerance, c, radius, q)) return false;
-                const Vec3 axis = normalized(tube.axis);
-                const Vec3 t =
-                    tube.kind == FitKind::kCylinder
-                        ? axis
-                        : normalized(cross(axis, perpendicular_part(c - tube.point, axis)));
+                const Vec3 t = spine_direction(tube, c);
                 // Least squares along t onto the remaining surfaces (linearised).
                 double num = 0, den = 0;
                 for (std::size_t k = 0; k < on.size(); ++k) {

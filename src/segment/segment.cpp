@@ -137,8 +137,9 @@ constexpr int kRefineRounds = 3;
 /// at most this share of the tolerance, and a facet is on it when its vertices are within that
 /// share: a CAD tessellation's vertices lie on their faces to rounding (fillet block at 345k
 /// facets: 0.000-0.016), while a surface grown across a tangent line or an analytic piece of
-/// a free-form blend holds its vertices at 0.04-0.4 of the tolerance (NIST CTC 02's tori). A
-/// noisy mesh's tolerance is six times its noise (kNoiseFactor): none of its surfaces is exact.
+/// a free-form blend holds its vertices at 0.04-0.4 of the tolerance (NIST CTC 02's tori; both
+/// by a temporary print). A noisy mesh's tolerance is six times its noise (kNoiseFactor): none
+/// of its surfaces is exact.
 constexpr double kExactShare = 0.05;
 /// Passes of border refinement, the regions refitted after each (see refine_borders()): a
 /// bound on the work, not a tuning; the passes stop when no facet moves.
