@@ -550,13 +550,20 @@ TopoDS_Shape build_spherical_pocket(Dims& d) {
     if (!face.IsDone()) throw ModelError("pocket profile failed");
     BRepPrimAPI_MakeRevol rev(face.Face(), gp_Ax1(frame.Location(), frame.Direction()), 2 * kPi);
     part = cut(part, rev.Shape(), "spherical pocket");
-    // A groove a ball end mill leaves: a cylinder with a sphere at either end.
+    // A groove a ball end mill leaves: a cylinder with a sphere at either end. Each sphere's
+    // seam (the meridian along its frame's x direction) lies inside the cylinder, as a ball end
+    // mill leaves each end one spherical face: with the seam outside, the end ball came as two
+    // faces of one sphere, which no mesh can tell apart.
     const double gx0 = 0.66 * L, gz = H + rb - gdepth;
     TopoDS_Shape groove =
         BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(gx0, cy, gz), gp_Dir(1, 0, 0)), rb, glen).Shape();
-    groove = fuse(groove, BRepPrimAPI_MakeSphere(gp_Pnt(gx0, cy, gz), rb).Shape(), "ball start");
-    groove =
-        fuse(groove, BRepPrimAPI_MakeSphere(gp_Pnt(gx0 + glen, cy, gz), rb).Shape(), "ball end");
+    const auto ball = [&](double x, double inward) {
+        return BRepPrimAPI_MakeSphere(
+                   gp_Ax2(gp_Pnt(x, cy, gz), gp_Dir(0, 0, 1), gp_Dir(inward, 0, 0)), rb)
+            .Shape();
+    };
+    groove = fuse(groove, ball(gx0, 1), "ball start");
+    groove = fuse(groove, ball(gx0 + glen, -1), "ball end");
     return cut(part, groove, "ball groove");
 }
 
