@@ -645,7 +645,10 @@ TEST(ReverseSurfaces, CornersOfFourSurfacesAreOneVertex) {
 // crossing, cut off a sliver. seamed_band() joins the band's two loops by a seam of its own
 // between them: 797 -> 81 faces, no fallback. Lone facets whose rings no surface took whole
 // now grow by a greedy pick from their rings that keeps generators (strip_fit(), the second
-// try): 81 -> 64 faces (34 -> 20 planes), volume 0.98 -> 0.58 % off.
+// try): 81 -> 64 faces (34 -> 20 planes), volume 0.98 -> 0.58 % off. The volume is measured in
+// pieces of one turn where a face goes round its surface more than once, as the thread's crest
+// and root do (solid_volume()): measured whole, BRepGProp put it 1.41 % over (0.50 % by its
+// default rule, which also put the original 1.3 % low); it is within 0.1 %.
 TEST(ReverseSurfaces, AThreadedScrewIsNotBuiltWhollyPlanar) {
     const auto path = corpus_step_dir() / "build123d_M6-1x12-countersunk-screw.step";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus at " << path;
@@ -654,6 +657,8 @@ TEST(ReverseSurfaces, AThreadedScrewIsNotBuiltWhollyPlanar) {
     for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << f.reason;
     EXPECT_EQ(o.report.faces_by_kind.count("facet"), 0u);
     EXPECT_LE(o.report.faces, 70u);
+    EXPECT_NEAR(o.report.solid_volume, o.true_volume, 1e-3 * o.true_volume);
+    EXPECT_NEAR(o.back.volume, o.true_volume, 1e-3 * o.true_volume);
     ASSERT_TRUE(o.report.deviation.has_value());
     EXPECT_LE(o.report.deviation->mesh_to_solid.max, 2 * o.deflection);
     EXPECT_LE(o.report.deviation->solid_to_mesh.max, 2 * o.deflection);

@@ -21,7 +21,8 @@ std::string check_failure(const TopoDS_Shape& shape, std::vector<TopoDS_Shape>* 
 /// bench cases pay 0.1-0.4 s for it (docs/benchmarks.md).
 constexpr double kVolumeRelativeError = 1e-7;
 
-/// The volume of `shape` (a solid, or a shape holding one) within kVolumeRelativeError.
+/// The volume of `shape` (a solid, or a shape holding one) within kVolumeRelativeError; a face
+/// that goes round its periodic surface more than once is measured in pieces of one turn.
 double solid_volume(const TopoDS_Shape& shape);
 
 }  // namespace ncrev::brep_detail
