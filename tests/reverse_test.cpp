@@ -446,6 +446,18 @@ TEST(ReverseSurfaces, RollingBallCornersAreWhereTheSpinesTouch) {
     EXPECT_LE(std::abs(o.back.volume - o.true_volume), 1e-6 * o.true_volume);
 }
 
+// The sample part `name` meshed as `ncrev sample NAME --deflection D --angular A` meshes it
+// (without its STEP text).
+SamplePart finely_meshed(const char* name, double deflection, double angular) {
+    SampleOptions so;
+    so.with_step = false;
+    so.deflection = deflection;
+    so.angular_deflection = angular;
+    Result<SamplePart> made = make_sample_part(name, so);
+    EXPECT_TRUE(made.ok()) << name;
+    return std::move(made).value();
+}
+
 // The fillet block meshed finely (0.0005 mm, 0.05 rad: 96 612 facets). Its fillets' regions
 // grew across their tangent lines: each top fillet came as an exact piece and a cylinder
 // between it and its neighbours (r 3.98 reaching 1.4 mm into the corner tori, or r 3.76 over a
@@ -459,13 +471,8 @@ TEST(ReverseSurfaces, RollingBallCornersAreWhereTheSpinesTouch) {
 // the refinement alone, as volumes were measured then (BRepGProp's default rule, before
 // 60dd34f); here, measured adaptively, it is 1.6e-7 off.
 TEST(ReverseSurfaces, AFinelyMeshedFilletBlockIsExact) {
-    SampleOptions so;
-    so.with_step = false;
-    so.deflection = 0.0005;
-    so.angular_deflection = 0.05;
-    Result<SamplePart> made = make_sample_part("fillet_chamfer_block", so);
-    ASSERT_TRUE(made.ok());
-    const Outcome o = reverse_part(made.value(), false, ReverseMethod::kAuto, "fine_block");
+    const SamplePart part = finely_meshed("fillet_chamfer_block", 0.0005, 0.05);
+    const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "fine_block");
     expect_solid(o, "fine_block");
     EXPECT_TRUE(o.report.fallbacks.empty());
     EXPECT_EQ(o.report.faces, 26u);
@@ -485,19 +492,13 @@ TEST(ReverseSurfaces, AFinelyMeshedFilletBlockIsExact) {
 // and the torus's did not close (2 fallbacks). The feet are now taken in their order round the
 // torus's axis (in_spine_order()).
 TEST(ReverseSurfaces, AFinelyMeshedShaftsShoulderFilletIsExact) {
-    SampleOptions so;
-    so.with_step = false;
-    so.deflection = 0.0005;
-    so.angular_deflection = 0.03;
-    Result<SamplePart> made = make_sample_part("turned_shaft", so);
-    ASSERT_TRUE(made.ok());
+    SamplePart part = finely_meshed("turned_shaft", 0.0005, 0.03);
     const auto dir = out_dir() / "fine_shaft";
-    Result<SampleFiles> files = write_sample_part(made.value(), dir);
+    Result<SampleFiles> files = write_sample_part(part, dir);
     ASSERT_TRUE(files.ok());
     Result<TriangleSoup> stl = read_mesh_file(files->stl);
     std::filesystem::remove_all(dir);
     ASSERT_TRUE(stl.ok());
-    SamplePart part = std::move(made).value();
     part.mesh = std::move(stl).value();
     const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "fine_shaft");
     expect_solid(o, "fine_shaft");
