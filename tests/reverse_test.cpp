@@ -487,10 +487,10 @@ TEST(ReverseSurfaces, AFinelyMeshedFilletBlockIsExact) {
 
 // The turned shaft meshed finely (0.0005 mm, 0.03 rad: 385 590 facets), read from its STL as a
 // user would. Its shoulder fillet (a torus) touches the shoulder plane along a whole circle;
-// the mesh's border there zigzags, and of the 586 contact feet of its vertices 6 went back
-// along the circle. The periodic cubic through them looped: the plane's wire crossed itself
-// and the torus's did not close (2 fallbacks). The feet are now taken in their order round the
-// torus's axis (in_spine_order()).
+// the mesh's border there zigzags, and 6 of the 585 steps between its vertices' contact feet
+// went back along the circle or repeated a foot. The periodic cubic through them looped: the
+// plane's wire crossed itself and the torus's did not close (2 fallbacks). The feet are now taken
+// in their order round the torus's axis (in_spine_order()).
 TEST(ReverseSurfaces, AFinelyMeshedShaftsShoulderFilletIsExact) {
     SamplePart part = finely_meshed("turned_shaft", 0.0005, 0.03);
     const auto dir = out_dir() / "fine_shaft";

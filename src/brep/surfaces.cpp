@@ -615,7 +615,8 @@ double spine_parameter(const Surface& s, Vec3 c) {
 // fillet at 386k facets: 6 of its 585 steps went back or repeated, and its plane's wire
 // crossed itself). Left as they are for a ball (its spine is a point), and for a loop that
 // does not go once round a torus's axis.
-void in_spine_order(const Surface& tube, std::vector<double>& along, std::vector<gp_Pnt>& feet) {
+void in_spine_order(const Surface& tube, const std::vector<double>& along,
+                    std::vector<gp_Pnt>& feet) {
     const std::size_t n = feet.size();
     if (n < 3 || (tube.kind != FitKind::kCylinder && tube.kind != FitKind::kTorus)) return;
     // Unwrapped: each step of a torus's angle taken the short way round.
@@ -654,18 +655,14 @@ void in_spine_order(const Surface& tube, std::vector<double>& along, std::vector
     std::stable_sort(inner.begin(), inner.end(),
                      [&](std::size_t i, std::size_t j) { return (u[i] - u[j]) * span < 0; });
     std::vector<gp_Pnt> sorted{feet.front()};
-    std::vector<double> at{along.front()};
     double last = u[0];
     for (std::size_t k : inner) {
         if (!((u[k] - last) * span > 0)) continue;
         sorted.push_back(feet[k]);
-        at.push_back(along[k]);
         last = u[k];
     }
     sorted.push_back(feet.back());
-    at.push_back(along.back());
     feet = std::move(sorted);
-    along = std::move(at);
 }
 
 // Where two tangent surfaces touch along a chain: one of them a tube (the one of smaller radius
