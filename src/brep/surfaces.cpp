@@ -107,6 +107,19 @@ constexpr double kJunctionSpan = 2;
 // shoulder fillet at 386k facets went back 6 steps of 585, by 0.3 % of its turn; NIST FTC 07's
 // chains that are not along a contact go back 1 step of 3 or more.
 constexpr double kBacktrackShare = 0.05;
+// Of two tubes tangent along a chain, the one whose spine points travel along the chain less
+// than this share of as far as the other's is not taken as the tube (tangency_points()): a bore
+// and the torus rounding its end touch along a circle round the bore's axis, where the bore's
+// spine points are one point (NIST FTC 10 at 0.04 mm: 0 against the chain's length), and the
+// feet of that point pile up. Any share between the two would do.
+constexpr double kStillSpine = 0.5;
+// A curve through tangency feet is taken when it is within this many tolerances of both
+// surfaces (build_surface_brep()): surfaces that each hold the chain's vertices within the
+// tolerance are within twice it of each other where they touch. A curve farther off runs
+// through feet of surfaces that do not touch there, and the curve through points solved onto
+// both is nearer (a B-spline beside a torus on NIST FTC 10 at 0.02 mm: feet 0.17 mm, 10
+// tolerances, off, and the B-spline's wire crossed itself; 0.03 mm through solved points).
+constexpr double kTouchTolerances = 2;
 // Points of a chain used to choose and trim an intersection branch (all when fewer).
 constexpr std::size_t kChainSamples = 24;
 // Facet centroids used to find which way a surface's natural normal points.
@@ -666,7 +679,8 @@ void in_spine_order(const Surface& tube, const std::vector<double>& along,
 }
 
 // Where two tangent surfaces touch along a chain: one of them a tube (the one of smaller radius
-// when both are), the foot on the other of the tube's spine point nearest each chain vertex.
+// when both are, unless its spine stands still: kStillSpine), the foot on the other of the
+// tube's spine point nearest each chain vertex.
 // False when neither is a tube, or a foot is not at the tube's radius from its spine within
 // `tolerance` (the surfaces do not touch there).
 bool tangency_points(const Surface& a, const Surface& b, const Mesh& m,
@@ -677,7 +691,29 @@ bool tangency_points(const Surface& a, const Surface& b, const Mesh& m,
     const Vec3 p0 = m.position(chain[chain.size() / 2]);
     const bool ta = spine_point(a, p0, c, ra), tb = spine_point(b, p0, c, rb);
     if (!ta && !tb) return false;
-    const bool a_tube = ta && (!tb || ra <= rb);
+    // The length of the path of a surface's spine points along the chain (0 for a ball).
+    const auto travel = [&](const Surface& s) {
+        double length = 0;
+        Vec3 prev, at;
+        double r = 0;
+        for (std::size_t k = 0; k < chain.size(); ++k) {
+            if (!spine_point(s, m.position(chain[k]), at, r)) return 0.0;
+            if (k > 0) length += norm(at - prev);
+            prev = at;
+        }
+        return length;
+    };
+    // The tube of smaller radius, unless its spine stands still along the chain while the
+    // other's runs with it (kStillSpine).
+    bool a_tube = ta && (!tb || ra <= rb);
+    if (ta && tb) {
+        const double along_a = travel(a), along_b = travel(b);
+        if (a_tube && along_a < kStillSpine * along_b) {
+            a_tube = false;
+        } else if (!a_tube && along_b < kStillSpine * along_a) {
+            a_tube = true;
+        }
+    }
     const Surface& tube = a_tube ? a : b;
     const Surface& other = a_tube ? b : a;
     out.clear();
@@ -1022,44 +1058,51 @@ bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, C
         p = std::move(kept);
     }
     if (p.size() < (closed ? 3u : 2u)) return false;
-    if (linear) {
-        if (closed) p.push_back(p.front());
-        const int n = static_cast<int>(p.size());
-        TColgp_Array1OfPnt poles(1, n);
-        TColStd_Array1OfReal knots(1, n);
-        TColStd_Array1OfInteger mults(1, n);
-        double len = 0;
-        for (int i = 0; i < n; ++i) {
-            const auto k = static_cast<std::size_t>(i);
-            if (i > 0) len += p[k].Distance(p[k - 1]);
-            poles.SetValue(i + 1, p[k]);
-            knots.SetValue(i + 1, len);
-            mults.SetValue(i + 1, (i == 0 || i == n - 1) ? 2 : 1);
+    // OpenCASCADE throws where it finds the points unfit for a curve (tangency feet heaped on
+    // one another, as kStillSpine's were): no curve from these points then, and the caller
+    // tries its other points rather than give up the chain.
+    try {
+        if (linear) {
+            if (closed) p.push_back(p.front());
+            const int n = static_cast<int>(p.size());
+            TColgp_Array1OfPnt poles(1, n);
+            TColStd_Array1OfReal knots(1, n);
+            TColStd_Array1OfInteger mults(1, n);
+            double len = 0;
+            for (int i = 0; i < n; ++i) {
+                const auto k = static_cast<std::size_t>(i);
+                if (i > 0) len += p[k].Distance(p[k - 1]);
+                poles.SetValue(i + 1, p[k]);
+                knots.SetValue(i + 1, len);
+                mults.SetValue(i + 1, (i == 0 || i == n - 1) ? 2 : 1);
+            }
+            out.curve = new Geom_BSplineCurve(poles, knots, mults, 1);
+            out.first = 0;
+            out.last = len;
+            out.deviation = 0;
+            return true;
         }
-        out.curve = new Geom_BSplineCurve(poles, knots, mults, 1);
-        out.first = 0;
-        out.last = len;
-        out.deviation = 0;
-        return true;
+        Handle(TColgp_HArray1OfPnt) arr = new TColgp_HArray1OfPnt(1, static_cast<int>(p.size()));
+        for (std::size_t i = 0; i < p.size(); ++i) arr->SetValue(static_cast<int>(i) + 1, p[i]);
+        // The whole curve.
+        const auto whole = [&out](const Handle(Geom_Curve) & c) {
+            out.curve = c;
+            out.first = c->FirstParameter();
+            out.last = c->LastParameter();
+            out.deviation = 0;
+            return true;
+        };
+        if (approximate > 0) {
+            if (closed || p.size() <= kApproximateFrom) return false;
+            GeomAPI_PointsToBSpline fit(arr->Array1(), 3, 8, GeomAbs_C2, approximate);
+            return fit.IsDone() && whole(fit.Curve());
+        }
+        GeomAPI_Interpolate interp(arr, closed, kMinTolerance);
+        interp.Perform();
+        return interp.IsDone() && whole(interp.Curve());
+    } catch (const Standard_Failure&) {
+        return false;
     }
-    Handle(TColgp_HArray1OfPnt) arr = new TColgp_HArray1OfPnt(1, static_cast<int>(p.size()));
-    for (std::size_t i = 0; i < p.size(); ++i) arr->SetValue(static_cast<int>(i) + 1, p[i]);
-    // The whole curve.
-    const auto whole = [&out](const Handle(Geom_Curve) & c) {
-        out.curve = c;
-        out.first = c->FirstParameter();
-        out.last = c->LastParameter();
-        out.deviation = 0;
-        return true;
-    };
-    if (approximate > 0) {
-        if (closed || p.size() <= kApproximateFrom) return false;
-        GeomAPI_PointsToBSpline fit(arr->Array1(), 3, 8, GeomAbs_C2, approximate);
-        return fit.IsDone() && whole(fit.Curve());
-    }
-    GeomAPI_Interpolate interp(arr, closed, kMinTolerance);
-    interp.Perform();
-    return interp.IsDone() && whole(interp.Curve());
 }
 
 // `pts` with points inserted between each two by bisection: the middle of a span goes where
@@ -2183,7 +2226,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             // spine point nearest each chain point. Solving onto both surfaces instead is
             // ill-conditioned there: any point of the band where they are within the
             // tolerance of each other is a solution, and the curve wanders across it.
-            // Taken when the curve through those points is within the tolerance of both
+            // Taken when the curve through those points is within kTouchTolerances of both
             // surfaces (two cylinders crossing at a shallow angle are not tangent along a
             // curve, and the feet are not where they meet).
             std::vector<gp_Pnt> touch;
@@ -2229,7 +2272,8 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     if (!touch.empty() &&
                         fitted_curve(touch, ch.closed, linear[ra] || linear[rb], best)) {
                         best.deviation = curve_off_surfaces(best, sa, sb, samples);
-                        touched = best.deviation <= max_tol && !strays_from(best, touch, stray);
+                        touched = best.deviation <= kTouchTolerances * opt.tolerance &&
+                                  !strays_from(best, touch, stray);
                         if (!touched) best.deviation = -1;
                     }
                     // First the approximation within half the tolerance, taken when it
