@@ -1096,6 +1096,7 @@ TEST(ReverseStudy, DISABLED_Corpus) {
         if (only && path.filename().string().find(only) == std::string::npos) continue;
         SampleOptions so;
         so.relative_deflection = 1e-3;
+        if (const char* d = std::getenv("RELATIVE")) so.relative_deflection = std::atof(d);
         if (const char* d = std::getenv("DEFLECTION")) so.deflection = std::atof(d);  // mm
         if (const char* a = std::getenv("ANGULAR")) so.angular_deflection = std::atof(a);
         Result<SamplePart> made = sample_from_step(path, so);
