@@ -1083,6 +1083,27 @@ TEST(ReverseSurfaces, ABoreMeetsTheTorusRoundingItsEnd) {
     expect_near_the_part(o, "ftc10_fine");
 }
 
+// NIST FTC 07 meshed 4 x finer than issue 8's tessellation (87.8k facets): two edge fillets
+// and their corner torus are nearly tangent to one another and to the top plane, and their
+// common point, solved 0.12 mm from the mesh vertex, lay past one fillet's tangent line with
+// the plane: that fillet's wire crossed itself, and so did seven other regions' (8 fallbacks,
+// 433 faces for 269). A corner of a face that still crosses itself after every other remedy
+// goes back to its mesh vertex (vertex_at): 1 fallback.
+TEST(ReverseSurfaces, IllConditionedCornersGoBackToTheirMeshVertex) {
+    const auto path = corpus_step_dir() / "nist_ftc_07_asme1_rd.stp";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    SampleOptions so;
+    so.relative_deflection = 2.5e-4;
+    so.angular_deflection = 0.1;
+    Result<SamplePart> made = sample_from_step(path, so);
+    ASSERT_TRUE(made.ok()) << made.error().describe();
+    const Outcome o = reverse_part(made.value(), false, ReverseMethod::kAuto, "ftc07_fine");
+    expect_solid(o, "ftc07_fine");
+    EXPECT_LE(o.report.fallbacks.size(), 1u);
+    EXPECT_LE(o.report.faces, o.true_faces);
+    EXPECT_NEAR(o.report.solid_volume, o.true_volume, 1e-4 * o.true_volume);
+}
+
 TEST(ReverseStudy, DISABLED_Corpus) {
     // THREADS=n: at most n threads (results must not depend on it).
     std::optional<tbb::global_control> threads;

@@ -1709,6 +1709,7 @@ struct GeometryCache {
         bool valid = false;
         std::vector<std::int32_t> on;
         bool contact_allowed = false;
+        bool at_vertex = false;  // kept at its mesh vertex (moved_at)
         Vec3 point{};
         double tolerance = 0;
         bool solved = false;  // had surfaces to be solved onto
@@ -1781,6 +1782,12 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     // Corners (mesh vertex ids) solved without it after a face or chain at them failed with it
     // (a corner moved along a coarse mesh's contact band can pass its chain's next point).
     std::unordered_set<std::uint32_t> plain_at;
+    // Corners kept at their mesh vertex after a face at them crossed itself with every other
+    // remedy tried (moved_at): surfaces nearly tangent to one another leave their common point
+    // ill-conditioned. Two fillets and their corner torus on NIST FTC 07 at 88k facets: solved
+    // 0.12 mm from the mesh vertex, past the tangent line of one fillet with the top plane and
+    // 0.09 mm above that plane, so the fillet's end edge crossed its tangent-line edge.
+    std::unordered_set<std::uint32_t> vertex_at;
     // Regions whose facets changed since their geometry was made (all, at first; a region
     // absorbed and its absorber after try_absorb()).
     std::vector<std::uint8_t> reshaped(nr, 1);
@@ -2005,16 +2012,22 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     BRep_Builder B;
     // Corner v solved onto the surfaces of the regions `on`.
     const auto solve_corner = [&](VertexId v, const std::vector<std::int32_t>& on_ids,
-                                  bool contact_allowed) {
+                                  bool contact_allowed, bool at_vertex) {
         GeometryCache::Corner c;
         c.valid = true;
         c.on = on_ids;
         c.contact_allowed = contact_allowed;
+        c.at_vertex = at_vertex;
         std::vector<Surface> on;
         for (std::int32_t r : on_ids) on.push_back(regions[static_cast<std::size_t>(r)].surface);
         Vec3 p = m.position(v);
         double tol = kMinTolerance;
-        if (!on.empty()) {
+        if (at_vertex) {
+            double d = 0;
+            for (const Surface& s : on) d = std::max(d, distance(s, p));
+            tol = std::max(tol, 1.01 * d);
+            c.residual = d;
+        } else if (!on.empty()) {
             CommonPoint cp = common_point(on, p);
             // Two tangent surfaces leave the solve free along their contact band: the corner
             // goes onto their contact curve when that is within the tolerance of every surface
@@ -2066,6 +2079,9 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         std::unordered_map<std::uint32_t, TopoDS_Vertex> vertex;
         // Per region, its corners put on a contact curve this round.
         std::vector<std::vector<std::uint32_t>> contact_at(nr);
+        // Per region, its corners solved plainly this round more than the tolerance from their
+        // mesh vertex (which the tessellation put on the part): moved there by the solve.
+        std::vector<std::vector<std::uint32_t>> moved_at(nr);
         const auto contact_corner = [&](std::size_t r) { return !contact_at[r].empty(); };
         // Back to plain for the next round: the corners of region r that were on a contact
         // curve (false when it had none).
@@ -2086,11 +2102,16 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 if (!fallback[k]) on.push_back(r);
                 if (k < opt.plain_corners.size() && opt.plain_corners[k]) contact_allowed = false;
             }
+            const bool at_vertex = vertex_at.count(v.idx()) != 0;
             GeometryCache::Corner& c = cache.corners[v.idx()];
             if (!opt.reuse_geometry || !c.valid || c.on != on ||
-                c.contact_allowed != contact_allowed) {
-                c = solve_corner(v, on, contact_allowed);
+                c.contact_allowed != contact_allowed || c.at_vertex != at_vertex) {
+                c = solve_corner(v, on, contact_allowed, at_vertex);
                 ++out.corners_solved;
+            }
+            if (c.solved && !c.on_contact && norm(c.point - m.position(v)) > opt.tolerance) {
+                for (std::int32_t r : around)
+                    moved_at[static_cast<std::size_t>(r)].push_back(v.idx());
             }
             if (c.solved) {
                 ++out.corners;
@@ -2754,16 +2775,22 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             // get another round (all of them in the last).
             bool retry = false;
             for (const auto& [r, why] : failed_region) {
+                bool tried = false;
                 if (is_band_face[r] && !own_seam[r]) {
                     own_seam[r] = 1;
-                    retry = true;
+                    tried = true;
                 }
-                if (make_plain(r)) retry = true;
-                if (!linear[r] && (why.find("SelfIntersectingWire") != std::string::npos ||
-                                   why == kUntriangulated)) {
+                if (make_plain(r)) tried = true;
+                const bool crossed = why.find("SelfIntersectingWire") != std::string::npos;
+                if (!linear[r] && (crossed || why == kUntriangulated)) {
                     linear[r] = 1;
-                    retry = true;
+                    tried = true;
                 }
+                // Last, its plainly solved corners that moved back to their mesh vertices.
+                if (!tried && crossed) {
+                    for (std::uint32_t v : moved_at[r]) tried = vertex_at.insert(v).second || tried;
+                }
+                retry = retry || tried;
             }
             if (retry && round < kMaxRounds) continue;
             bool absorbed_any = false;
