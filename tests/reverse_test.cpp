@@ -1089,7 +1089,16 @@ TEST(ReverseSurfaces, ABoreMeetsTheTorusRoundingItsEnd) {
 // the plane: that fillet's wire crossed itself, and so did seven other regions' (8 fallbacks,
 // 433 faces for 269). A corner of a face that still crosses itself after every other remedy
 // goes back to its mesh vertex (vertex_at): 1 fallback.
+// (20 s in Release; under the sanitizers it ran past ctest's 300 s limit in CI, so it is
+// skipped there, and the retry it asserts is not run under them by any other test known.)
 TEST(ReverseSurfaces, IllConditionedCornersGoBackToTheirMeshVertex) {
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "too slow under AddressSanitizer";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+    GTEST_SKIP() << "too slow under AddressSanitizer";
+#endif
+#endif
     const auto path = corpus_step_dir() / "nist_ftc_07_asme1_rd.stp";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
     SampleOptions so;

@@ -2023,10 +2023,12 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         Vec3 p = m.position(v);
         double tol = kMinTolerance;
         if (at_vertex) {
+            // Counted with the solved corners (the report's largest residual includes it).
             double d = 0;
             for (const Surface& s : on) d = std::max(d, distance(s, p));
             tol = std::max(tol, 1.01 * d);
             c.residual = d;
+            c.solved = !on.empty();
         } else if (!on.empty()) {
             CommonPoint cp = common_point(on, p);
             // Two tangent surfaces leave the solve free along their contact band: the corner
