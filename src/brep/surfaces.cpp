@@ -110,8 +110,9 @@ constexpr double kBacktrackShare = 0.05;
 // Of two tubes tangent along a chain, the one whose spine points travel along the chain less
 // than this share of as far as the other's is not taken as the tube (tangency_points()): a bore
 // and the torus rounding its end touch along a circle round the bore's axis, where the bore's
-// spine points are one point (NIST FTC 10 at 0.04 mm: 0 against the chain's length), and the
-// feet of that point pile up. Any share between the two would do.
+// spine points are one point (0 against the chain's length), and the feet of that point pile up
+// (NIST FTC 10 at 0.02 mm: within 1e-11 mm, a temporary print). Any share between the two
+// would do.
 constexpr double kStillSpine = 0.5;
 // A curve through tangency feet is taken when it is within this many tolerances of both
 // surfaces (build_surface_brep()): surfaces that each hold the chain's vertices within the
@@ -2022,45 +2023,45 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
         for (std::int32_t r : on_ids) on.push_back(regions[static_cast<std::size_t>(r)].surface);
         Vec3 p = m.position(v);
         double tol = kMinTolerance;
-        if (at_vertex) {
-            // Counted with the solved corners (the report's largest residual includes it).
-            double d = 0;
-            for (const Surface& s : on) d = std::max(d, distance(s, p));
-            tol = std::max(tol, 1.01 * d);
-            c.residual = d;
-            c.solved = !on.empty();
-        } else if (!on.empty()) {
-            CommonPoint cp = common_point(on, p);
-            // Two tangent surfaces leave the solve free along their contact band: the corner
-            // goes onto their contact curve when that is within the tolerance of every surface
-            // and within the band (its half-width sqrt(2 r tol), r the tube's radius).
-            // A junction of two tubes (spine_junction()) is unique within the span it was
-            // searched in: the mesh vertex may be far from it along the contact (1.35 mm at a
-            // 4 mm fillet's corner torus at a tolerance of 0.011 mm, the fillet block at 345k
-            // facets, where a line and a circle of contact are tangent on the top face).
-            Vec3 q = cp.point;
-            double radius = 0;
-            bool junction = false;
-            if (contact_allowed && on.size() >= 3 &&
-                tangent_corner(on, opt.tolerance, q, radius, junction)) {
-                double residual = 0;
-                for (const Surface& s : on) residual = std::max(residual, distance(s, q));
-                const double band = std::sqrt(2 * radius * opt.tolerance);
-                const double reach = junction ? kJunctionSpan * radius : max_tol + 2 * band;
-                if (residual <= opt.tolerance && norm(q - p) <= reach) {
-                    cp.point = q;
-                    cp.residual = residual;
-                    c.on_contact = true;
+        if (!on.empty()) {
+            c.solved = true;
+            bool placed = false;  // at a point the surfaces hold
+            if (!at_vertex) {
+                CommonPoint cp = common_point(on, p);
+                // Two tangent surfaces leave the solve free along their contact band: the
+                // corner goes onto their contact curve when that is within the tolerance of
+                // every surface and within the band (its half-width sqrt(2 r tol), r the tube's
+                // radius). A junction of two tubes (spine_junction()) is unique within the span
+                // it was searched in: the mesh vertex may be far from it along the contact
+                // (1.35 mm at a 4 mm fillet's corner torus at a tolerance of 0.011 mm, the
+                // fillet block at 345k facets, where a line and a circle of contact are tangent
+                // on the top face).
+                Vec3 q = cp.point;
+                double radius = 0;
+                bool junction = false;
+                if (contact_allowed && on.size() >= 3 &&
+                    tangent_corner(on, opt.tolerance, q, radius, junction)) {
+                    double residual = 0;
+                    for (const Surface& s : on) residual = std::max(residual, distance(s, q));
+                    const double band = std::sqrt(2 * radius * opt.tolerance);
+                    const double reach = junction ? kJunctionSpan * radius : max_tol + 2 * band;
+                    if (residual <= opt.tolerance && norm(q - p) <= reach) {
+                        cp.point = q;
+                        cp.residual = residual;
+                        c.on_contact = true;
+                    }
+                }
+                if (cp.residual <= opt.tolerance &&
+                    (c.on_contact || norm(cp.point - p) <= max_tol)) {
+                    p = cp.point;
+                    tol = std::max(tol, 1.01 * cp.residual);
+                    c.residual = cp.residual;
+                    placed = true;
                 }
             }
-            c.solved = true;
-            if (cp.residual <= opt.tolerance && (c.on_contact || norm(cp.point - p) <= max_tol)) {
-                p = cp.point;
-                tol = std::max(tol, 1.01 * cp.residual);
-                c.residual = cp.residual;
-            } else {
-                // Unsolved (surfaces nearly tangent, or a bad fit): the mesh vertex, with the
-                // tolerance that reaches every surface.
+            if (!placed) {
+                // The mesh vertex, with the tolerance that reaches every surface: unsolved
+                // (surfaces nearly tangent, or a bad fit), or kept there (vertex_at).
                 double d = 0;
                 for (const Surface& s : on) d = std::max(d, distance(s, p));
                 tol = std::max(tol, 1.01 * d);
