@@ -1948,10 +1948,12 @@ std::optional<Vec3> strip_direction(const Context& c, std::span<const std::uint3
 /// kLooseRms x the deflection: not an analytic face of the file) seed groups, largest first;
 /// a group takes its smooth neighbours that are loose or small (at most kSmallRegion facets:
 /// their fit says nothing), largest first, one by one while one B-spline (fit_group()) still
-/// fits it all. The first loose neighbour it cannot take ends the group's growth: a free-form
-/// face that one height field cannot cover (NIST CTC 02's blends, closed rings round drafted
-/// walls, in 5-7 pieces each) comes back in a few B-splines, and a larger free-form area (the
-/// link rods' faces, tangent to each other all round) in patches. Their borders are tangent
+/// fits it all. The first loose neighbour it cannot take, once the group is one to keep (see
+/// below; until then it grows on past it: NIST FTC 10's blend meshed at 139k facets met such
+/// neighbours at two pieces, and came back as a B-spline and three tori), ends the group's
+/// growth: a free-form face that one height field cannot cover (NIST CTC 02's blends, closed
+/// rings round drafted walls, in 5-7 pieces each) comes back in a few B-splines, and a larger
+/// free-form area (the link rods' faces, tangent to each other all round) in patches. Their borders are tangent
 /// seams between two B-splines, whose edges go through points midway between the two
 /// (docs/brep.md); until those, such a group stayed in pieces (growing on past a refused
 /// neighbour made groups steep enough to fold their net, 19 fallbacks and 5.8 deflections off on
@@ -1995,6 +1997,11 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
     for (const std::uint32_t s : seeds) {
         if (taken[s] || nbrs[s].empty()) continue;
         std::vector<std::uint32_t> group{s}, frontier;
+        const auto curved_in = [&](const std::vector<std::uint32_t>& g) {
+            return static_cast<std::size_t>(std::count_if(g.begin(), g.end(), [&](std::uint32_t p) {
+                return fitted[p].fit.surface.kind != FitKind::kPlane;
+            }));
+        };
         mark[s] = s;
         const auto reach = [&](std::uint32_t r) {
             for (const std::uint32_t n : nbrs[r]) {
@@ -2025,14 +2032,14 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
                 faces = std::move(more);
                 best = std::move(r);
                 reach(n);
-            } else if (seed(n)) {
-                break;  // a loose neighbour it cannot take: grown as far as it goes
+            } else if (seed(n) && curved_in(group) >= kFreeformMinPieces) {
+                // A loose neighbour it cannot take: grown as far as it goes. A group too small
+                // to keep grows on past it instead; stopping would drop the group.
+                break;
             }
         }
-        const auto curved = std::count_if(group.begin(), group.end(), [&](std::uint32_t p) {
-            return fitted[p].fit.surface.kind != FitKind::kPlane;
-        });
-        if (static_cast<std::size_t>(curved) < kFreeformMinPieces) continue;
+        const auto curved = curved_in(group);
+        if (curved < kFreeformMinPieces) continue;
         const std::optional<Analytic> simple = analytic_instead(c, best, faces);
         std::sort(faces.begin(), faces.end());
         drafts[s].faces = std::move(faces);
