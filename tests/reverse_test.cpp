@@ -1062,19 +1062,26 @@ TEST(ReverseSurfaces, TangencyCurvesStayAlongTheirJunction) {
     EXPECT_LE(o.report.deviation->solid_to_mesh.max, 0.4 * o.deflection);
 }
 
+// The corpus file `name` tessellated with `so` and reversed from its triangles; nullopt where
+// the file is missing.
+std::optional<Outcome> reverse_corpus_mesh(const char* name, const SampleOptions& so,
+                                           const std::string& tag) {
+    const auto path = corpus_step_dir() / name;
+    if (!std::filesystem::exists(path)) return std::nullopt;
+    Result<SamplePart> made = sample_from_step(path, so);
+    EXPECT_TRUE(made.ok()) << made.error().describe();
+    if (!made.ok()) return std::nullopt;
+    return reverse_part(made.value(), false, ReverseMethod::kAuto, tag);
+}
+
 // NIST FTC 10 meshed at 0.04 mm / 0.1 rad (139k facets), reversed once for the two tests
 // below; nullptr where the corpus file is missing.
 const Outcome* ftc10_fine() {
-    static const std::optional<Outcome> o = []() -> std::optional<Outcome> {
-        const auto path = corpus_step_dir() / "nist_ftc_10_asme1_rb.stp";
-        if (!std::filesystem::exists(path)) return std::nullopt;
+    static const std::optional<Outcome> o = [] {
         SampleOptions so;
         so.deflection = 0.04;
         so.angular_deflection = 0.1;
-        Result<SamplePart> made = sample_from_step(path, so);
-        EXPECT_TRUE(made.ok()) << made.error().describe();
-        if (!made.ok()) return std::nullopt;
-        return reverse_part(made.value(), false, ReverseMethod::kAuto, "ftc10_fine");
+        return reverse_corpus_mesh("nist_ftc_10_asme1_rb.stp", so, "ftc10_fine");
     }();
     return o ? &*o : nullptr;
 }
@@ -1120,16 +1127,11 @@ TEST(ReverseSurfaces, AFreeformBlendMeshedFinelyIsNotInAnalyticPieces) {
 // sanitizers it ran past ctest's 300 s limit in CI, so both are skipped there, and what they
 // assert is not run under them by any other test known.)
 const Outcome* ftc07_fine() {
-    static const std::optional<Outcome> o = []() -> std::optional<Outcome> {
-        const auto path = corpus_step_dir() / "nist_ftc_07_asme1_rd.stp";
-        if (!std::filesystem::exists(path)) return std::nullopt;
+    static const std::optional<Outcome> o = [] {
         SampleOptions so;
         so.relative_deflection = 2.5e-4;
         so.angular_deflection = 0.1;
-        Result<SamplePart> made = sample_from_step(path, so);
-        EXPECT_TRUE(made.ok()) << made.error().describe();
-        if (!made.ok()) return std::nullopt;
-        return reverse_part(made.value(), false, ReverseMethod::kAuto, "ftc07_fine");
+        return reverse_corpus_mesh("nist_ftc_07_asme1_rd.stp", so, "ftc07_fine");
     }();
     return o ? &*o : nullptr;
 }

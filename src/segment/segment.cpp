@@ -1953,8 +1953,8 @@ std::optional<Vec3> strip_direction(const Context& c, std::span<const std::uint3
 /// neighbours at two pieces, and came back as a B-spline and three tori), ends the group's
 /// growth: a free-form face that one height field cannot cover (NIST CTC 02's blends, closed
 /// rings round drafted walls, in 5-7 pieces each) comes back in a few B-splines, and a larger
-/// free-form area (the link rods' faces, tangent to each other all round) in patches. Their borders are tangent
-/// seams between two B-splines, whose edges go through points midway between the two
+/// free-form area (the link rods' faces, tangent to each other all round) in patches. Their borders
+/// are tangent seams between two B-splines, whose edges go through points midway between the two
 /// (docs/brep.md); until those, such a group stayed in pieces (growing on past a refused
 /// neighbour made groups steep enough to fold their net, 19 fallbacks and 5.8 deflections off on
 /// the link rods). With kFreeformMinPieces curved pieces (a few planes of a facet or two between
