@@ -1994,14 +1994,14 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
     std::sort(seeds.begin(), seeds.end(), larger);
     std::vector<std::uint8_t> taken(drafts.size(), 0);
     std::vector<std::uint32_t> mark(drafts.size(), kNone);  // last seed that met it
+    const auto curved_in = [&](const std::vector<std::uint32_t>& group) {
+        return static_cast<std::size_t>(std::count_if(
+            group.begin(), group.end(),
+            [&](std::uint32_t p) { return fitted[p].fit.surface.kind != FitKind::kPlane; }));
+    };
     for (const std::uint32_t s : seeds) {
         if (taken[s] || nbrs[s].empty()) continue;
         std::vector<std::uint32_t> group{s}, frontier;
-        const auto curved_in = [&](const std::vector<std::uint32_t>& g) {
-            return static_cast<std::size_t>(std::count_if(g.begin(), g.end(), [&](std::uint32_t p) {
-                return fitted[p].fit.surface.kind != FitKind::kPlane;
-            }));
-        };
         mark[s] = s;
         const auto reach = [&](std::uint32_t r) {
             for (const std::uint32_t n : nbrs[r]) {
@@ -2038,8 +2038,7 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
                 break;
             }
         }
-        const auto curved = curved_in(group);
-        if (curved < kFreeformMinPieces) continue;
+        if (curved_in(group) < kFreeformMinPieces) continue;
         const std::optional<Analytic> simple = analytic_instead(c, best, faces);
         std::sort(faces.begin(), faces.end());
         drafts[s].faces = std::move(faces);
