@@ -571,6 +571,25 @@ TEST(ReverseSurfaces, CoarseFilletFansAreChords) {
     expect_near_the_part(o, name);
 }
 
+// The NIST crada plate's lettering: walls along the letters' spline outlines, B-spline strips
+// of 2-20 mm2 in 6-26 facets each, which the mesh (at 0.14 mm) shows as tangent cylinders of
+// 0.4-3 mm radius. Two such cylinders (10 numbers) leave the cubic profile of an extrusion
+// fitted to both 3 poles, so no group of them grew to the three pieces it takes to keep one:
+// 180 faces for 150 on one surface (109 cylinders). A group too small to keep whose pieces are
+// one wall's (merge_loose_pieces(): cylinders about one axis, planes along it) is held to the
+// parameters of one that is: 153, with 18 B-splines.
+TEST(ReverseSurfaces, LetteringWallsAreExtrusionsNotArcs) {
+    const auto path = corpus_step_dir() / "nist_mtc_crada_plate.step";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "crada");
+    expect_exact(o, "crada");
+    ASSERT_GT(o.one_surface_faces, 0u);
+    EXPECT_LE(static_cast<double>(o.report.faces), 1.05 * static_cast<double>(o.one_surface_faces))
+        << o.report.faces << " faces for " << o.one_surface_faces << " on one surface";
+    ASSERT_TRUE(o.report.deviation.has_value());
+    EXPECT_EQ(o.report.deviation->faces_without_triangles, 0u);
+}
+
 // A region whose exact face cannot be built (no edge curve with a neighbour, a wire that
 // crosses itself, a face that fails read back) comes back as one face on its own surface,
 // bounded by the mesh edges of its border, not as its facets: the link rods' five (walls one

@@ -1457,6 +1457,11 @@ std::uint64_t merge_freeform(Context& c, std::vector<Draft>& drafts) {
 /// fillets a corner torus joins: a vertical fillet round a pocket's corner and the floor fillet
 /// beside it. CAD places them exactly; a fitted axis is off by a few thousandths.
 constexpr double kCornerAxesSine = 0.01;
+/// Cylinders whose axes are this close to parallel (sine of the angle), and planes whose
+/// normals are this close to perpendicular to them, may be pieces of one wall extruded along a
+/// spline outline (merge_loose_pieces()): as kCornerAxesSine, a fitted axis is off by a few
+/// thousandths (the NIST crada plate's lettering: up to 0.002).
+constexpr double kWallAxesSine = 0.01;
 
 /// The torus where two fillets meet at a corner (see corner_surfaces()): about `a`'s axis, through
 /// the point of it nearest `b`'s axis, its spine at the distance between the two axes, its tube
@@ -1999,6 +2004,23 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
             group.begin(), group.end(),
             [&](std::uint32_t p) { return fitted[p].fit.surface.kind != FitKind::kPlane; }));
     };
+    // Whether the group with n are pieces of one wall: cylinders about one direction (a wall
+    // along a spline outline, in arcs) and planes along it.
+    const auto wall_of = [&](const std::vector<std::uint32_t>& group, std::uint32_t n) {
+        std::vector<std::uint32_t> all = group;
+        all.push_back(n);
+        const auto cylinder = std::find_if(all.begin(), all.end(), [&](std::uint32_t p) {
+            return fitted[p].fit.surface.kind == FitKind::kCylinder;
+        });
+        if (cylinder == all.end()) return false;
+        const Vec3 e = fitted[*cylinder].fit.surface.axis;
+        return std::all_of(all.begin(), all.end(), [&](std::uint32_t p) {
+            const Surface& sf = fitted[p].fit.surface;
+            return sf.kind == FitKind::kCylinder ? norm(cross(e, sf.axis)) <= kWallAxesSine
+                   : sf.kind == FitKind::kPlane  ? std::fabs(dot(e, sf.axis)) <= kWallAxesSine
+                                                 : false;
+        });
+    };
     for (const std::uint32_t s : seeds) {
         if (taken[s] || nbrs[s].empty()) continue;
         std::vector<std::uint32_t> group{s}, frontier;
@@ -2024,9 +2046,19 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
             more.insert(more.end(), drafts[n].faces.begin(), drafts[n].faces.end());
             const Pieces with{whole.parameters + free_parameters(fitted[n].fit.surface),
                               std::max(whole.rms, fitted[n].fit.rms)};
-            FitResult r = fit_group(c, more, with);
+            // A group still too small to keep is held to the parameters of one that is, its
+            // pieces' mean times kFreeformMinPieces: two tangent cylinders of a spline wall (10
+            // numbers) leave a cubic profile 3 poles, none fits, and the group never grows to
+            // the three pieces it takes to be kept. A group kept has passed the real count: its
+            // last piece taken made it one to keep.
+            const std::size_t curved_with =
+                curved_in(group) + (fitted[n].fit.surface.kind != FitKind::kPlane ? 1 : 0);
+            Pieces budget = with;
+            if (curved_with < kFreeformMinPieces && wall_of(group, n))
+                budget.parameters = with.parameters * kFreeformMinPieces / (group.size() + 1);
+            FitResult r = fit_group(c, more, budget);
             if (r.ok && chords_agree(c, r.surface, more) &&
-                (!r.surface.bspline->extruded || extrusion_pays(r, with))) {
+                (!r.surface.bspline->extruded || extrusion_pays(r, budget))) {
                 group.push_back(n);
                 whole = with;
                 faces = std::move(more);
