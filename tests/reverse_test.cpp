@@ -1008,7 +1008,10 @@ TEST(ReverseSurfaces, CornerToriAreTheOnesTheirFilletsMake) {
 // ring in a few B-splines, within 5 % of the part's count. Two of those B-splines meet at 15-18
 // degrees without crossing on their junction (each within δ of its points): no intersection
 // or solved point was on it and one fell back to mesh edges; the curve through points midway
-// between the two takes it (docs/brep.md, 4).
+// between the two takes it (docs/brep.md, 4). A B-spline refitted to its vertices alone swung
+// 2.8 mm (2.4 δ) off a border edge's middle once a 27-facet ring piece took two leftover facets,
+// and no edge curve followed it; a refit is kept only while its facets' and border edges'
+// middles stay within 2 δ (docs/brep.md, 1).
 TEST(ReverseSurfaces, WideDraftedWallsTakeTheirFacets) {
     if (corpus_steps().empty()) GTEST_SKIP() << "no corpus at " << corpus_step_dir();
     const SamplePart part = corpus_part(corpus_step_dir() / "nist_ctc_02_asme1_rc.stp");
@@ -1041,7 +1044,10 @@ TEST(ReverseSurfaces, WideDraftedWallsTakeTheirFacets) {
 // of small pieces is now one extruded B-spline where one fits (merge_loose_pieces()): 26
 // one-facet regions, 99 faces, 5 fallbacks (the two walls' faces among them: bounded by their
 // mesh edges; the best curves along their junctions 2-4 x the deflection off both neighbours,
-// a temporary print).
+// a temporary print). The one-facet planes left along the B-spline patches' seams, their
+// corners 0.0007-0.0010 mm off a patch (the tolerance 0.00056 mm, the deflection 0.0054 mm),
+// now join it, as a patch holds its own facets (absorb_small_regions() after the patches are
+// made): 75 -> 63 faces, 22 -> 8 one-facet regions.
 TEST(ReverseSurfaces, TangentJunctionsOfFittedPiecesHaveEdges) {
     const auto path = corpus_step_dir() / "occt_linkrods.step";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
@@ -1049,9 +1055,9 @@ TEST(ReverseSurfaces, TangentJunctionsOfFittedPiecesHaveEdges) {
     ASSERT_TRUE(o.report.segmentation.has_value());
     std::size_t lone = 0;
     for (const Region& g : o.report.segmentation->regions) lone += g.facets == 1;
-    EXPECT_LE(lone, 30u);
+    EXPECT_LE(lone, 12u);
     expect_solid(o, "linkrods");
-    EXPECT_LE(o.report.faces, 105u);
+    EXPECT_LE(o.report.faces, 68u);
     EXPECT_LE(o.report.fallbacks.size(), 5u);
     expect_near_the_part(o, "linkrods");
 }

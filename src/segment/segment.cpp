@@ -1659,6 +1659,32 @@ std::uint64_t absorb_small_regions(Context& c, std::vector<Draft>& drafts) {
                     if (best != kNone) break;
                     if (other != kNone && chord_fits(c, drafts[other].surface, f)) best = other;
                 }
+                // Nor so: a B-spline neighbour, held to the deflection, not the tolerance (a
+                // free-form face is known only as well as its tessellation samples it), takes
+                // it on the same terms: corners within the deflection, middle within twice (as
+                // chords_agree() holds a B-spline's facets). The link rods' one-facet planes
+                // between a free-form face and its neighbours: corners 0.0007-0.0010 mm off
+                // it, the tolerance 0.00056 mm, the deflection 0.0054 mm. Not a loose
+                // analytic region's (held to the deflection too): OCCT's TR12J then had 40
+                // faces on fallbacks for 11, a B-spline beside them as its facets.
+                if (best == kNone) {
+                    double best_corner = c.sag;
+                    for (const std::uint32_t other : joinable) {
+                        if (other == kNone) continue;
+                        const Draft& o = drafts[other];
+                        if (o.surface.kind != FitKind::kBSpline) continue;
+                        double corner = 0;
+                        for (int i = 0; i < 3; ++i) {
+                            corner = std::max(
+                                corner, distance(o.surface, c.m.position(c.m.vertex(fid(f), i))));
+                        }
+                        if (corner <= best_corner &&
+                            distance(o.surface, c.fd.centroid[f]) <= 2 * c.sag) {
+                            best_corner = corner;
+                            best = other;
+                        }
+                    }
+                }
                 if (best == kNone) {
                     kept.push_back(f);
                     continue;
@@ -2355,6 +2381,16 @@ double finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRec
         result.freeform_groups += merged.size();
         for (const std::uint32_t g : merge_chords(c, drafts)) merged.push_back(g);
         for (const std::uint32_t g : grow_loose(c, drafts)) merged.push_back(g);
+        // The groups' new surfaces may take the small regions left between them and their
+        // neighbours (one-facet planes along a free-form face's seams), as the regions before
+        // the final fits took theirs; a region that took or gave facets is fitted again.
+        if (!merged.empty()) {
+            std::vector<std::size_t> before(drafts.size());
+            for (std::uint32_t r = 0; r < drafts.size(); ++r) before[r] = drafts[r].faces.size();
+            result.reassigned_facets += absorb_small_regions(c, drafts);
+            for (std::uint32_t r = 0; r < drafts.size(); ++r)
+                if (drafts[r].alive && drafts[r].faces.size() != before[r]) merged.push_back(r);
+        }
         std::sort(merged.begin(), merged.end());
         merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
         std::erase_if(merged, [&](std::uint32_t r) { return !drafts[r].alive; });
