@@ -309,6 +309,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         }
         for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
             const std::int32_t rf = sr.region[FaceId(f)];
+            if (rf < 0) continue;
             const auto r = static_cast<std::size_t>(rf);
             if (seen[r].empty()) continue;
             Vec3 sum{0, 0, 0};

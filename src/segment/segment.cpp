@@ -2385,11 +2385,11 @@ double finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRec
         // neighbours (one-facet planes along a free-form face's seams), as the regions before
         // the final fits took theirs; a region that took or gave facets is fitted again.
         if (!merged.empty()) {
-            std::vector<std::size_t> before(drafts.size());
-            for (std::uint32_t r = 0; r < drafts.size(); ++r) before[r] = drafts[r].faces.size();
+            std::vector<std::vector<std::uint32_t>> before(drafts.size());
+            for (std::uint32_t r = 0; r < drafts.size(); ++r) before[r] = drafts[r].faces;
             result.reassigned_facets += absorb_small_regions(c, drafts);
             for (std::uint32_t r = 0; r < drafts.size(); ++r)
-                if (drafts[r].alive && drafts[r].faces.size() != before[r]) merged.push_back(r);
+                if (drafts[r].alive && drafts[r].faces != before[r]) merged.push_back(r);
         }
         std::sort(merged.begin(), merged.end());
         merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
