@@ -1047,7 +1047,7 @@ TEST(ReverseSurfaces, WideDraftedWallsTakeTheirFacets) {
 // a temporary print). The one-facet planes left along the B-spline patches' seams, their
 // corners 0.0007-0.0010 mm off a patch (the tolerance 0.00056 mm, the deflection 0.0054 mm),
 // now join it, as a patch holds its own facets (absorb_small_regions() after the patches are
-// made): 75 -> 63 faces, 22 -> 8 one-facet regions.
+// made): 75 -> 63 faces, 22 -> 7 one-facet regions.
 TEST(ReverseSurfaces, TangentJunctionsOfFittedPiecesHaveEdges) {
     const auto path = corpus_step_dir() / "occt_linkrods.step";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;

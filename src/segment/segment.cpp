@@ -352,18 +352,20 @@ double chord_sag(const Surface& s, double len, std::span<const Vec3> corners) {
     return rho > 0 ? std::min(len * len / (8 * rho), rho) : 0;
 }
 
-/// Facet f as a chord of s where the deflection estimate is too tight: its corners within the
-/// tolerance, its middle no farther than a chord of its longest side across s (chord_sag()).
-/// BRepMesh's fans on the large fillets of NIST CTC 05 sag 2.1 - 3.5 x the estimate with every
-/// corner on the torus to rounding: 24 one-facet planes. Only for leftovers no neighbour takes
-/// otherwise: a cap triangle of a plane on a bore's rim is a chord of the bore too.
-bool chord_fits(const Context& c, const Surface& s, std::uint32_t f) {
+/// Facet f as a chord of s where the deflection estimate is too tight: its corners within
+/// `corners` (the tolerance, or the deflection for a surface held to that), its middle no
+/// farther than a chord of its longest side across s (chord_sag()), nor than kMiddleSagFactor
+/// deflections. BRepMesh's fans on the large fillets of NIST CTC 05 sag 2.1 - 3.5 x the
+/// estimate with every corner on the torus to rounding: 24 one-facet planes. Only for leftovers
+/// no neighbour takes otherwise: a cap triangle of a plane on a bore's rim is a chord of the
+/// bore too.
+bool chord_fits(const Context& c, const Surface& s, std::uint32_t f, double corners) {
     std::array<Vec3, 3> p;
     for (int i = 0; i < 3; ++i)
         p[static_cast<std::size_t>(i)] = c.m.position(c.m.vertex(fid(f), i));
     double len = 0;
     for (std::size_t i = 0; i < 3; ++i) {
-        if (distance(s, p[i]) > c.tol) return false;
+        if (distance(s, p[i]) > corners) return false;
         len = std::max(len, norm(p[(i + 1) % 3] - p[i]));
     }
     const double mid = distance(s, c.fd.centroid[f]);
@@ -992,7 +994,7 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
                 const Surface& own = drafts[from].surface;
                 double on_own = 0, on_to = 0;
                 for (const std::uint32_t f : drafts[from].faces) {
-                    if (!chord_fits(c, st, f)) return false;  // (all facet_cost() takes too)
+                    if (!chord_fits(c, st, f, c.tol)) return false;  // (all facet_cost() takes too)
                     for (int i = 0; i < 3; ++i) {
                         const Vec3 p = c.m.position(c.m.vertex(fid(f), i));
                         on_own = std::max(on_own, distance(own, p));
@@ -1657,33 +1659,22 @@ std::uint64_t absorb_small_regions(Context& c, std::vector<Draft>& drafts) {
                 // across that surface can (chord_fits()).
                 for (const std::uint32_t other : joinable) {
                     if (best != kNone) break;
-                    if (other != kNone && chord_fits(c, drafts[other].surface, f)) best = other;
+                    if (other != kNone && chord_fits(c, drafts[other].surface, f, c.tol))
+                        best = other;
                 }
                 // Nor so: a B-spline neighbour, held to the deflection, not the tolerance (a
                 // free-form face is known only as well as its tessellation samples it), takes
-                // it on the same terms: corners within the deflection, middle within twice (as
-                // chords_agree() holds a B-spline's facets). The link rods' one-facet planes
-                // between a free-form face and its neighbours: corners 0.0007-0.0010 mm off
-                // it, the tolerance 0.00056 mm, the deflection 0.0054 mm. Not a loose
-                // analytic region's (held to the deflection too): OCCT's TR12J then had 40
+                // it as such a chord with its corners within the deflection (its middle then
+                // within kMiddleSagFactor deflections, as chords_agree() holds a B-spline's). The
+                // link rods' one-facet planes between a free-form face and its neighbours: corners
+                // 0.0007-0.0010 mm off it, the tolerance 0.00056 mm, the deflection 0.0054 mm. Not
+                // a loose analytic region's (held to the deflection too): OCCT's TR12J then had 40
                 // faces on fallbacks for 11, a B-spline beside them as its facets.
-                if (best == kNone) {
-                    double best_corner = c.sag;
-                    for (const std::uint32_t other : joinable) {
-                        if (other == kNone) continue;
-                        const Draft& o = drafts[other];
-                        if (o.surface.kind != FitKind::kBSpline) continue;
-                        double corner = 0;
-                        for (int i = 0; i < 3; ++i) {
-                            corner = std::max(
-                                corner, distance(o.surface, c.m.position(c.m.vertex(fid(f), i))));
-                        }
-                        if (corner <= best_corner &&
-                            distance(o.surface, c.fd.centroid[f]) <= 2 * c.sag) {
-                            best_corner = corner;
-                            best = other;
-                        }
-                    }
+                for (const std::uint32_t other : joinable) {
+                    if (best != kNone) break;
+                    if (other != kNone && drafts[other].surface.kind == FitKind::kBSpline &&
+                        chord_fits(c, drafts[other].surface, f, c.sag))
+                        best = other;
                 }
                 if (best == kNone) {
                     kept.push_back(f);
