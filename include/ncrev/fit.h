@@ -72,6 +72,18 @@ struct BSplineSurface {
     /// A linear extrusion (fit_bspline()): num_v is 4 and each row across is one pole of a
     /// planar profile moved along one line, so the surface is exactly linear that way.
     bool extruded = false;
+    /// A helical sweep (fit_bspline()): each column along u is one planar profile's poles, the
+    /// rows along v follow one helix about one axis (within a small part of the tolerance), so
+    /// the surface is a thread's flank.
+    bool helical = false;
+    /// A helical sweep's motion: the axis through `origin` along unit `axis`, angles measured
+    /// from unit `x` (normal to the axis) towards axis x x, `pitch` the climb per radian; the
+    /// surface spans the angles [a0, a1] from v = 0 to 1, its profile's heights about `h`
+    /// (the height less pitch x angle). Projections start from it (closest_point()).
+    struct Helix {
+        Vec3 origin, axis{0, 0, 1}, x{1, 0, 0};
+        double pitch = 0, a0 = 0, a1 = 0, h = 0;
+    } helix;
     /// The surface at the grid of parameters where projections onto it start (distance(),
     /// closest_point(), normal_at()), filled by fit_bspline(); evaluated on each call when
     /// empty. A cache: it must hold the grid's points of these poles.
@@ -146,6 +158,12 @@ FitResult residuals(const Surface& surface, const FitInput& input);
 /// as the line that meets every normal line); spheres and planes do not. A B-spline is fitted
 /// to within 1e-4 of the points' extent (see fit_bspline()). Never throws.
 FitResult fit(FitKind kind, const FitInput& input);
+
+/// A helical sweep only (what fit_bspline() tries after a linear extrusion): a planar profile
+/// swept along a helix about an axis found from the normals and refined on the points — a
+/// thread's flank. ok false when the points are no such sweep within `tolerance`; the surface
+/// is a B-spline with `helical` set.
+FitResult fit_helical(const FitInput& input, double tolerance);
 
 /// A cubic B-spline surface. First as a linear extrusion when the normals are all normal to one
 /// direction (a pocket wall cut along a spline outline, which folds back over its mean plane):

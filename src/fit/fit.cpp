@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -1252,8 +1253,8 @@ void project_bspline(const BSplineSurface& b, Vec3 p, double& u, double& v) {
 /// profile does not depend on the height).
 void start_grid(const BSplineSurface& b, int& gu, int& gv) {
     constexpr int kGrid = 16;
-    gu = b.extruded ? kProfileGrid * b.num_u : kGrid;
-    gv = b.extruded ? 0 : kGrid;
+    gu = b.extruded || b.helical ? kProfileGrid * b.num_u : kGrid;
+    gv = b.extruded ? 0 : b.helical ? std::max(kGrid, 2 * (b.num_v - 3)) : kGrid;
 }
 
 /// The parameters of the grid's point (i, j).
@@ -1278,14 +1279,30 @@ void fill_starts(BSplineSurface& b) {
         for (int i = 0; i <= gu; ++i) b.starts.push_back(start_point(b, gu, gv, i, j));
 }
 
-/// The nearest of the grid of start_grid(): a start for project_bspline().
+/// The nearest of the grid of start_grid(): a start for project_bspline(). On a helical sweep
+/// only the rows beside the point's own turn (its angle about the axis on the turn whose
+/// height is nearest the profile's): the grid has two rows a knot span along a helix of
+/// hundreds, and a scan of it all was most of the time of segmenting a finely meshed thread.
 void coarse_start(const BSplineSurface& b, Vec3 p, double& u, double& v) {
     double best = std::numeric_limits<double>::infinity();
     int gu = 0, gv = 0;
     start_grid(b, gu, gv);
     const bool cached = b.starts.size() == static_cast<std::size_t>((gu + 1) * (gv + 1));
     int bi = 0, bj = 0;
-    for (int j = 0; j <= gv; ++j) {
+    int j0 = 0, j1 = gv;
+    const BSplineSurface::Helix& hx = b.helix;
+    if (b.helical && hx.a1 > hx.a0 && hx.pitch != 0 && gv > 0) {
+        const Vec3 d = p - hx.origin;
+        const double z = dot(d, hx.axis);
+        const double th = std::atan2(dot(d, cross(hx.axis, hx.x)), dot(d, hx.x));
+        const double turn = std::round((z - hx.pitch * th - hx.h) / (2 * kPi * hx.pitch));
+        const double at = std::clamp((th + 2 * kPi * turn - hx.a0) / (hx.a1 - hx.a0), 0.0, 1.0);
+        if (std::isfinite(at)) {
+            const int j = static_cast<int>(std::lround(at * gv));
+            j0 = std::max(0, j - 1), j1 = std::min(gv, j + 1);
+        }
+    }
+    for (int j = j0; j <= j1; ++j) {
         for (int i = 0; i <= gu; ++i) {
             const Vec3 q = (cached ? b.starts[static_cast<std::size_t>(i + (gu + 1) * j)]
                                    : start_point(b, gu, gv, i, j)) -
@@ -1695,6 +1712,22 @@ bool profile_parameters(const std::vector<double>& x, const std::vector<double>&
     return true;
 }
 
+/// A planar profile swept along a rigid motion (fit_extrusion(), fit_helical()): each point's
+/// coordinates (x, y) in the profile's plane and its normal's components there (ux, uy), and
+/// the B-spline surface of the profile whose poles are (px, py) in that plane, with `slack`
+/// how far that surface may be from the exact sweep of the profile (added to every residual).
+/// `point` and `axis` are the fit's (bspline_fit()).
+struct ProfileSweep {
+    std::vector<double> x, y, ux, uy;
+    Vec3 point, axis;
+    std::function<std::shared_ptr<BSplineSurface>(const Eigen::VectorXd& px,
+                                                  const Eigen::VectorXd& py, double& slack)>
+        make;
+};
+
+FitResult fit_profile_sweep(const FitInput& in, double tolerance, bool& capped,
+                            const ProfileSweep& sweep, FitResult fail);
+
 /// A linear extrusion: the points lie on lines along one direction e through a planar profile
 /// curve — the wall of a pocket whose outline is a spline, as a flat end mill cuts it. Such a wall
 /// folds back over its mean plane (no height field there), but its profile is a curve: a cubic
@@ -1726,11 +1759,36 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
         ux[i] = dot(in.normals[i], e1), uy[i] = dot(in.normals[i], e2);
         t0 = std::min(t0, t[i]), t1 = std::max(t1, t[i]);
     }
+    if (!(t1 > t0)) return fail;
+    ProfileSweep sweep{std::move(x), std::move(y), std::move(ux), std::move(uy), c, e, {}};
+    sweep.make = [c, e, e1, e2, t0, t1](const Eigen::VectorXd& px, const Eigen::VectorXd& py,
+                                        double& slack) {
+        const auto np = static_cast<int>(px.size());
+        auto bs = std::make_shared<BSplineSurface>();
+        bs->num_u = np, bs->num_v = 4;
+        bs->extruded = true;
+        bs->poles.resize(static_cast<std::size_t>(4 * np));
+        for (int j = 0; j < 4; ++j)
+            for (int a = 0; a < np; ++a)
+                bs->poles[static_cast<std::size_t>(a + np * j)] =
+                    c + px(a) * e1 + py(a) * e2 + (t0 + (t1 - t0) * j / 3.0) * e;
+        slack = 0;  // exactly the extrusion of the profile
+        return bs;
+    };
+    fail.failure = "the points along the extrusion are not one open profile";
+    return fit_profile_sweep(in, tolerance, capped, sweep, std::move(fail));
+}
+
+FitResult fit_profile_sweep(const FitInput& in, double tolerance, bool& capped,
+                            const ProfileSweep& sweep, FitResult fail) {
+    capped = false;
+    const std::size_t n = in.points.size();
+    const std::vector<double>& x = sweep.x;
+    const std::vector<double>& y = sweep.y;
+    double total = 0;
+    centroid(in, &total);
     std::vector<double> by_length, by_turn;
-    if (!(t1 > t0) || !profile_parameters(x, y, ux, uy, tolerance, by_length, by_turn)) {
-        fail.failure = "the points along the extrusion are not one open profile";
-        return fail;
-    }
+    if (!profile_parameters(x, y, sweep.ux, sweep.uy, tolerance, by_length, by_turn)) return fail;
     // An extrusion, but no net of the fewest poles is allowed: nothing to fit.
     if (in.max_profile_poles > 0 && in.max_profile_poles < kBSplineStartPoles) {
         capped = true;
@@ -1857,20 +1915,18 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
                 np < kBSplineMaxPoles)
                 return std::nullopt;
         }
-        auto bs = std::make_shared<BSplineSurface>();
-        bs->num_u = np, bs->num_v = 4;
-        bs->extruded = true;
-        bs->poles.resize(static_cast<std::size_t>(4 * np));
-        for (int j = 0; j < 4; ++j)
-            for (int a = 0; a < np; ++a)
-                bs->poles[static_cast<std::size_t>(a + np * j)] =
-                    c + px(a) * e1 + py(a) * e2 + (t0 + (t1 - t0) * j / 3.0) * e;
+        double slack = 0;
+        std::shared_ptr<BSplineSurface> bs = sweep.make(px, py, slack);
+        if (!bs) return std::nullopt;
         double sum = 0, mx = 0;
         for (std::size_t i = 0; i < n; ++i) {
-            sum += weight(in, i) * off[i] * off[i];
-            mx = std::max(mx, off[i]);
+            const double d = off[i] + slack;
+            sum += weight(in, i) * d * d;
+            mx = std::max(mx, d);
         }
-        return bspline_fit(std::move(bs), c, e, std::sqrt(sum / total), mx, 4 * np);
+        const int poles = bs->num_u * bs->num_v;
+        return bspline_fit(std::move(bs), sweep.point, sweep.axis, std::sqrt(sum / total), mx,
+                           poles);
     };
     // Nets of kNetGrowth x as many poles each time, the last of kBSplineMaxPoles; at each
     // size the start by length, then the one by turning. The first within the tolerance (and
@@ -1904,6 +1960,386 @@ FitResult fit_extrusion(const FitInput& in, double tolerance, bool& capped) {
     best.ok = false;
     if (!capped) best.failure = "no profile of up to the size limit of poles reaches the tolerance";
     return best;
+}
+
+/// A helical sweep's normals: the mean squared sine of the angle between a point's normal and the
+/// screw motion's velocity there, at most this (as kExtrusionNormals for an extrusion's lean:
+/// about 2.5 degrees; the velocity lies in the surface's tangent plane exactly).
+constexpr double kHelixNormals = 2e-3;
+/// The motion turns: its angular part at least this share of the unit vector (omega, v) found at
+/// the points' RMS radius from their centroid. Less is a translation (an extrusion's, which
+/// fit_extrusion() takes) or no motion at all.
+constexpr double kHelixMinTurn = 1e-2;
+/// The profile's points leave at least this share of the pitch free along the axis (the gap that
+/// says where one turn of the profile ends and the next begins): a sweep whose profile spans the
+/// whole pitch (a thread's flanks, crest and root together) has no open profile in one turn.
+constexpr double kHelixGap = 0.05;
+/// The B-spline along the helix: knot spans of at most this angle to start with (a cubic then
+/// follows the circle within about 1e-5 of its radius), halved while the surface strays more
+/// than kHelixSlack x the tolerance from the exact sweep; at most kHelixMaxSpans spans.
+constexpr double kHelixSpanAngle = kPi / 8;
+constexpr double kHelixSlack = 1e-3;
+constexpr int kHelixMaxSpans = 2048;
+
+/// The screw motion of fit_helical() refined on the points' distances: its normals' motion is
+/// off by the mesh's normals' own error (a flank of an M6 thread meshed at 0.02 mm: an axis
+/// 0.0003 rad and 0.002 mm off, a profile of 21 poles to reach the deflection, where the true
+/// motion leaves a straight line within 1e-5 mm). Levenberg-Marquardt on the motion (the axis'
+/// tilt and shift across itself, the pitch) and a profile of kRefinePoles poles together, each
+/// point's residual its signed distance from the profile in the half-plane it turns back into;
+/// the motion's columns by finite differences. At most kRefineRounds rounds, while a round
+/// lowers the RMS by kRefineGain. `angle` the points' unwrapped angles about the axis in the
+/// frame (e1, e2), kept as the branch each point's new angle is taken nearest to.
+constexpr int kRefinePoles = 4;
+constexpr int kRefineRounds = 30;
+constexpr double kRefineGain = 1e-3;
+void refine_screw(const FitInput& in, double tolerance, const std::vector<double>& angle, Vec3 e1,
+                  Vec3 e2, double scale, Vec3& axis, Vec3& origin, double& pitch) {
+    const std::size_t n = in.points.size();
+    constexpr int kMotion = 5;
+    const Vec3 a_in = axis, o_in = origin;
+    const double p_in = pitch;
+    // The point's place in the profile's half-plane under the motion changed by m.
+    const auto place = [&](const std::array<double, kMotion>& m, std::size_t i, double& x,
+                           double& y) {
+        const Vec3 a = normalized(a_in + m[0] * e1 + m[1] * e2);
+        const Vec3 o = o_in + m[2] * e1 + m[3] * e2;
+        const Vec3 g1 = normalized(e1 - dot(e1, a) * a), g2 = cross(a, g1);
+        const Vec3 d = in.points[i] - o;
+        const double px = dot(d, g1), py = dot(d, g2);
+        const double th = std::atan2(py, px);
+        const double turned = angle[i] + std::remainder(th - angle[i], 2 * kPi);
+        x = std::hypot(px, py);
+        y = dot(d, a) - (p_in + m[4]) * turned;
+    };
+    std::array<double, kMotion> m{};
+    std::vector<double> x(n), y(n), ux(n), uy(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        place(m, i, x[i], y[i]);
+        const Vec3 d = in.points[i] - origin;
+        const Vec3 radial = normalized(d - dot(d, axis) * axis);
+        ux[i] = dot(in.normals[i], radial), uy[i] = dot(in.normals[i], axis);
+    }
+    std::vector<double> s, s_turn;
+    if (!profile_parameters(x, y, ux, uy, tolerance, s, s_turn)) return;
+    double total = 0;
+    centroid(in, &total);
+    constexpr int np = kRefinePoles;
+    const std::vector<double> knots = cubic_knots(np);
+    // The profile's first poles: least squares at the parameters by length.
+    Eigen::VectorXd poles(2 * np);
+    {
+        Eigen::MatrixXd A = Eigen::MatrixXd::Zero(np, np);
+        Eigen::VectorXd bx = Eigen::VectorXd::Zero(np), by = Eigen::VectorXd::Zero(np);
+        for (std::size_t i = 0; i < n; ++i) {
+            double N[kMaxDegree + 1];
+            const int sp = cubic_basis(np, s[i], N, nullptr, knots.data()) - 3;
+            for (int a = 0; a <= 3; ++a) {
+                bx(sp + a) += weight(in, i) * N[a] * x[i],
+                    by(sp + a) += weight(in, i) * N[a] * y[i];
+                for (int b = 0; b <= 3; ++b) A(sp + a, sp + b) += weight(in, i) * N[a] * N[b];
+            }
+        }
+        A += kBSplineSmoothing * total * Eigen::MatrixXd::Identity(np, np);
+        const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
+        poles << ldlt.solve(bx), ldlt.solve(by);
+        if (ldlt.info() != Eigen::Success || !poles.allFinite()) return;
+    }
+    // Each point's residual (signed, along the profile's normal at its projection) and the
+    // profile's unit normal there; its parameter projected anew from the one before.
+    std::vector<double> res(n), nx(n), ny(n);
+    const auto residuals = [&](const std::array<double, kMotion>& mm, const Eigen::VectorXd& pl,
+                               std::vector<double>& par) {
+        double sum = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            double px = 0, py = 0;
+            place(mm, i, px, py);
+            double u = par[i], cx = 0, cy = 0, dx = 0, dy = 0;
+            for (int it = 0; it <= kProjectIterations; ++it) {
+                double N[kMaxDegree + 1], dN[kMaxDegree + 1];
+                const int sp = cubic_basis(np, u, N, dN, knots.data()) - 3;
+                cx = cy = dx = dy = 0;
+                for (int a = 0; a <= 3; ++a) {
+                    cx += N[a] * pl(sp + a), cy += N[a] * pl(np + sp + a);
+                    dx += dN[a] * pl(sp + a), dy += dN[a] * pl(np + sp + a);
+                }
+                const double dd = dx * dx + dy * dy;
+                if (it == kProjectIterations || !(dd > 0)) break;
+                const double nu = std::clamp(u - ((cx - px) * dx + (cy - py) * dy) / dd, 0.0, 1.0);
+                if (std::fabs(nu - u) < 1e-13) break;
+                u = nu;
+            }
+            par[i] = u;
+            const double l = std::hypot(dx, dy);
+            nx[i] = l > 0 ? -dy / l : 0, ny[i] = l > 0 ? dx / l : 0;
+            res[i] = (px - cx) * nx[i] + (py - cy) * ny[i];
+            sum += weight(in, i) * res[i] * res[i];
+        }
+        return std::sqrt(sum / total);
+    };
+    double rms = residuals(m, poles, s);
+    const double rms_in = rms;
+    const std::array<double, kMotion> step{1e-7, 1e-7, 1e-7 * scale, 1e-7 * scale, 1e-7 * scale};
+    double damping = 1e-6;
+    const int cols = 2 * np + kMotion;
+    for (int round = 0; round < kRefineRounds && rms > 0; ++round) {
+        Eigen::MatrixXd JtJ = Eigen::MatrixXd::Zero(cols, cols);
+        Eigen::VectorXd Jtr = Eigen::VectorXd::Zero(cols);
+        Eigen::VectorXd row(cols);
+        for (std::size_t i = 0; i < n; ++i) {
+            row.setZero();
+            double N[kMaxDegree + 1];
+            const int sp = cubic_basis(np, s[i], N, nullptr, knots.data()) - 3;
+            for (int a = 0; a <= 3; ++a)
+                row(sp + a) = -N[a] * nx[i], row(np + sp + a) = -N[a] * ny[i];
+            double px = 0, py = 0;
+            place(m, i, px, py);
+            for (int k = 0; k < kMotion; ++k) {
+                std::array<double, kMotion> mk = m;
+                mk[static_cast<std::size_t>(k)] += step[static_cast<std::size_t>(k)];
+                double qx = 0, qy = 0;
+                place(mk, i, qx, qy);
+                row(2 * np + k) =
+                    ((qx - px) * nx[i] + (qy - py) * ny[i]) / step[static_cast<std::size_t>(k)];
+            }
+            JtJ += weight(in, i) * row * row.transpose();
+            Jtr += weight(in, i) * res[i] * row;
+        }
+        bool better = false;
+        for (int tries = 0; tries < 8 && !better; ++tries, damping *= 10) {
+            Eigen::MatrixXd A = JtJ;
+            for (int k = 0; k < cols; ++k) A(k, k) += damping * std::max(JtJ(k, k), 1e-30);
+            const Eigen::VectorXd delta = A.ldlt().solve(-Jtr);
+            if (!delta.allFinite()) continue;
+            std::array<double, kMotion> mm = m;
+            for (int k = 0; k < kMotion; ++k) mm[static_cast<std::size_t>(k)] += delta(2 * np + k);
+            const Eigen::VectorXd pl = poles + delta.head(2 * np);
+            std::vector<double> par = s;
+            const std::vector<double> keep_res = res, keep_nx = nx, keep_ny = ny;
+            const double now = residuals(mm, pl, par);
+            if (now < rms) {
+                better = true;
+                const bool small_gain = now > (1 - kRefineGain) * rms;
+                m = mm, poles = pl, s = std::move(par), rms = now;
+                damping = std::max(damping / 100, 1e-12);
+                if (small_gain) round = kRefineRounds;
+            } else {
+                res = keep_res, nx = keep_nx, ny = keep_ny;
+            }
+        }
+        if (!better) break;
+    }
+    if (!(rms < rms_in)) return;
+    axis = normalized(a_in + m[0] * e1 + m[1] * e2);
+    origin = o_in + m[2] * e1 + m[3] * e2;
+    pitch = p_in + m[4];
+}
+
+/// A helical sweep: the points lie on helices about one axis, all of one pitch, through a planar
+/// profile curve — a thread's flank, as a thread mill, a tap or a die cuts it (a linear
+/// extrusion is the sweep without the turn, a surface of revolution the one without the
+/// climb). The screw motion comes from the normals: a surface swept by the motion with velocity
+/// field v(x) = omega x x + vbar has every normal normal to v, n . (omega x x) + n . vbar = 0,
+/// linear in (omega, vbar): the eigenvector of the smallest eigenvalue of the 6 x 6 normal
+/// equations (Pottmann and Randrup's kinematic surfaces). Its axis is omega's direction through
+/// omega x vbar / |omega|^2, its pitch per radian omega . vbar / |omega|^2. Each point, turned
+/// back along its helix into one half-plane through the axis (its angle about the axis and its
+/// height less the pitch's share of that angle, wrapped into one pitch at the profile's gap),
+/// is a point of the profile; the profile is fitted as an extrusion's is (fit_profile_sweep()),
+/// and swept over the points' span of angle as a B-spline surface: the profile's poles across
+/// (u), a cubic of uniform knot spans along the helix (v) that follows the circle within
+/// kHelixSlack x the tolerance, so exactly helical across and within that along. ok false
+/// when the normals fit no screw motion, the motion does not turn or climb, the profile is not
+/// one open curve in one turn, or no profile of up to kBSplineMaxPoles poles (or
+/// `max_profile_poles`: then `capped`) reaches `tolerance`.
+FitResult fit_helical(const FitInput& in, double tolerance, bool& capped) {
+    capped = false;
+    FitResult fail = failed(FitKind::kBSpline, "not a helical sweep");
+    const std::size_t n = in.points.size();
+    if (in.normals.size() != n || n < 16 || !(tolerance > 0)) return fail;
+    double total = 0;
+    const Vec3 c = centroid(in, &total);
+    double spread = 0;
+    for (std::size_t i = 0; i < n; ++i)
+        spread += weight(in, i) * dot(in.points[i] - c, in.points[i] - c);
+    const double scale = std::sqrt(spread / total);
+    if (!(scale > 0)) return fail;
+    // The normal equations of n . (omega x q) + n . vbar = (q x n) . omega + n . vbar, with q the
+    // points about their centroid in units of their RMS radius.
+    Eigen::Matrix<double, 6, 6> normal_eq = Eigen::Matrix<double, 6, 6>::Zero();
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 q = (in.points[i] - c) / scale;
+        const Vec3 qn = cross(q, in.normals[i]);
+        Eigen::Matrix<double, 6, 1> g;
+        g << qn.x, qn.y, qn.z, in.normals[i].x, in.normals[i].y, in.normals[i].z;
+        normal_eq += weight(in, i) * g * g.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(normal_eq);
+    if (eigen.info() != Eigen::Success) return fail;
+    const Eigen::Matrix<double, 6, 1> xi = eigen.eigenvectors().col(0);
+    const Vec3 omega{xi(0), xi(1), xi(2)}, vbar{xi(3), xi(4), xi(5)};
+    const double w2 = dot(omega, omega);
+    if (!(w2 >= kHelixMinTurn)) return fail;
+    double lean = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 v = cross(omega, (in.points[i] - c) / scale) + vbar;
+        const double speed = norm(v);
+        if (!(speed > 0)) return fail;
+        const double sine = dot(in.normals[i], v) / speed;
+        lean += weight(in, i) * sine * sine;
+    }
+    if (!(lean / total <= kHelixNormals)) return fail;
+    Vec3 axis = omega / std::sqrt(w2);
+    Vec3 origin = c + (scale / w2) * cross(omega, vbar);
+    double pitch = scale * dot(omega, vbar) / w2;  // climb per radian
+    const double period = 2 * kPi * std::fabs(pitch);
+    if (!(period > tolerance)) {
+        fail.failure = "the screw motion does not climb (a surface of revolution)";
+        return fail;
+    }
+    Vec3 e1, e2;
+    frame(axis, e1, e2);
+    std::vector<double> r(n), h(n), angle(n), ux(n), uy(n), wrapped(n);
+    double r_max = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 d = in.points[i] - origin;
+        const double z = dot(d, axis), px = dot(d, e1), py = dot(d, e2);
+        r[i] = std::hypot(px, py);
+        if (!(r[i] > 0)) return fail;
+        angle[i] = std::atan2(py, px);
+        h[i] = z - pitch * angle[i];
+        const Vec3 radial = (px * e1 + py * e2) / r[i];
+        ux[i] = dot(in.normals[i], radial), uy[i] = dot(in.normals[i], axis);
+        wrapped[i] = h[i] - period * std::floor(h[i] / period);
+        r_max = std::max(r_max, r[i]);
+    }
+    // The profile's turn starts after the widest gap of the heights wrapped into one pitch.
+    std::vector<double> sorted = wrapped;
+    std::sort(sorted.begin(), sorted.end());
+    double gap = sorted.front() + period - sorted.back(), start = sorted.front();
+    for (std::size_t k = 1; k < n; ++k) {
+        if (sorted[k] - sorted[k - 1] > gap) gap = sorted[k] - sorted[k - 1], start = sorted[k];
+    }
+    if (!(gap >= kHelixGap * period)) {
+        fail.failure = "the points span a whole pitch along the axis";
+        return fail;
+    }
+    double a0 = std::numeric_limits<double>::infinity(), a1 = -a0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double hp = wrapped[i] >= start ? wrapped[i] : wrapped[i] + period;
+        // z = h + pitch x angle = hp + pitch x (angle + 2 pi k)
+        const double turns = std::round((h[i] - hp) / (2 * kPi * pitch));
+        angle[i] += 2 * kPi * turns;
+        h[i] = hp;
+        a0 = std::min(a0, angle[i]), a1 = std::max(a1, angle[i]);
+    }
+    if (!(a1 > a0)) return fail;
+    // The motion refined on the points' distances, and the points turned back along it.
+    refine_screw(in, tolerance, angle, e1, e2, scale, axis, origin, pitch);
+    e1 = normalized(e1 - dot(e1, axis) * axis), e2 = cross(axis, e1);
+    a0 = std::numeric_limits<double>::infinity(), a1 = -a0, r_max = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 d = in.points[i] - origin;
+        const double px = dot(d, e1), py = dot(d, e2);
+        r[i] = std::hypot(px, py);
+        if (!(r[i] > 0)) return fail;
+        angle[i] += std::remainder(std::atan2(py, px) - angle[i], 2 * kPi);
+        h[i] = dot(d, axis) - pitch * angle[i];
+        const Vec3 radial = (px * e1 + py * e2) / r[i];
+        ux[i] = dot(in.normals[i], radial), uy[i] = dot(in.normals[i], axis);
+        a0 = std::min(a0, angle[i]), a1 = std::max(a1, angle[i]);
+        r_max = std::max(r_max, r[i]);
+    }
+    // The unit circle's direction d(phi) = cos phi e1 + sin phi e2 over [a0, a1] as a cubic
+    // B-spline (least squares on samples along each span), its poles' angles for the climb at
+    // the Greville abscissae (where a B-spline reproduces a linear function exactly).
+    int spans = std::max(1, static_cast<int>(std::ceil((a1 - a0) / kHelixSpanAngle)));
+    std::vector<double> dc, ds, phi;
+    double circle_err = 0;
+    for (;;) {
+        if (spans > kHelixMaxSpans) {
+            fail.failure = "the helix turns too often for a B-spline of the size limit";
+            return fail;
+        }
+        const int nv = spans + 3;
+        constexpr int kSamples = 8;  // per span, for the fit; twice as many for the check
+        // Banded (each sample touches 4 poles): a sparse factorization, as a long thread has
+        // thousands of poles along its helix.
+        std::vector<Eigen::Triplet<double>> entries;
+        entries.reserve(static_cast<std::size_t>(16 * (kSamples * spans + 1)));
+        Eigen::VectorXd bc = Eigen::VectorXd::Zero(nv), bsn = Eigen::VectorXd::Zero(nv);
+        for (int k = 0; k <= kSamples * spans; ++k) {
+            const double v = static_cast<double>(k) / (kSamples * spans);
+            const double f = a0 + v * (a1 - a0);
+            double N[kMaxDegree + 1];
+            const int sp = cubic_basis(nv, v, N, nullptr) - 3;
+            for (int a = 0; a <= 3; ++a) {
+                bc(sp + a) += N[a] * std::cos(f), bsn(sp + a) += N[a] * std::sin(f);
+                for (int b = 0; b <= 3; ++b) entries.emplace_back(sp + a, sp + b, N[a] * N[b]);
+            }
+        }
+        Eigen::SparseMatrix<double> A(nv, nv);
+        A.setFromTriplets(entries.begin(), entries.end());
+        const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(A);
+        if (ldlt.info() != Eigen::Success) return fail;
+        const Eigen::VectorXd pc = ldlt.solve(bc), ps = ldlt.solve(bsn);
+        if (ldlt.info() != Eigen::Success || !pc.allFinite() || !ps.allFinite()) return fail;
+        circle_err = 0;
+        for (int k = 0; k <= 2 * kSamples * spans; ++k) {
+            const double v = static_cast<double>(k) / (2 * kSamples * spans);
+            const double f = a0 + v * (a1 - a0);
+            double N[kMaxDegree + 1];
+            const int sp = cubic_basis(nv, v, N, nullptr) - 3;
+            double x = 0, y = 0;
+            for (int a = 0; a <= 3; ++a) x += N[a] * pc(sp + a), y += N[a] * ps(sp + a);
+            circle_err = std::max(circle_err, std::hypot(x - std::cos(f), y - std::sin(f)));
+        }
+        if (circle_err * r_max <= kHelixSlack * tolerance || spans * 2 > kHelixMaxSpans) {
+            if (circle_err * r_max > kHelixSlack * tolerance) {
+                fail.failure = "the helix turns too often for a B-spline of the size limit";
+                return fail;
+            }
+            dc.assign(pc.data(), pc.data() + nv);
+            ds.assign(ps.data(), ps.data() + nv);
+            const std::vector<double> knots = cubic_knots(nv);
+            phi.resize(static_cast<std::size_t>(nv));
+            for (int b = 0; b < nv; ++b) {
+                const auto k = static_cast<std::size_t>(b);
+                phi[k] = a0 + (a1 - a0) * (knots[k + 1] + knots[k + 2] + knots[k + 3]) / 3;
+            }
+            break;
+        }
+        spans *= 2;
+    }
+    double h_lo = std::numeric_limits<double>::infinity(), h_hi = -h_lo;
+    for (const double hh : h) h_lo = std::min(h_lo, hh), h_hi = std::max(h_hi, hh);
+    const double mid = 0.5 * (h_lo + h_hi);
+    ProfileSweep sweep{std::move(r), std::move(h), std::move(ux), std::move(uy), origin, axis, {}};
+    sweep.make = [origin, axis, e1, e2, pitch, dc, ds, phi, circle_err, mid](
+                     const Eigen::VectorXd& px, const Eigen::VectorXd& py, double& slack) {
+        const auto np = static_cast<int>(px.size());
+        const auto nv = static_cast<int>(phi.size());
+        auto bs = std::make_shared<BSplineSurface>();
+        bs->num_u = np, bs->num_v = nv;
+        bs->helical = true;
+        bs->helix = {origin, axis, e1, pitch, phi.front(), phi.back(), mid};
+        bs->poles.resize(static_cast<std::size_t>(np) * phi.size());
+        double reach = 0;
+        for (int b = 0; b < nv; ++b) {
+            const auto k = static_cast<std::size_t>(b);
+            const Vec3 dir = dc[k] * e1 + ds[k] * e2;
+            for (int a = 0; a < np; ++a)
+                bs->poles[static_cast<std::size_t>(a + np * b)] =
+                    origin + px(a) * dir + (py(a) + pitch * phi[k]) * axis;
+        }
+        for (int a = 0; a < np; ++a) reach = std::max(reach, std::fabs(px(a)));
+        // S(u, v) = sum_a N_a(u) (origin + px_a D(v) + (py_a + pitch phi(v)) axis): the exact
+        // sweep but for D's miss of the circle, scaled by the profile's reach.
+        slack = circle_err * reach;
+        return bs;
+    };
+    fail.failure = "the points turned back along their helices are not one open profile";
+    return fit_profile_sweep(in, tolerance, capped, sweep, std::move(fail));
 }
 
 FitResult fit_shear_cylinder(const FitInput& in) {
@@ -2175,6 +2611,17 @@ CommonPoint common_point(std::span<const Surface> surfaces, Vec3 start) {
     out.residual = 0;
     for (const Surface& s : surfaces) out.residual = std::max(out.residual, distance(s, p));
     return out;
+}
+
+FitResult fit_helical(const FitInput& in, double tolerance) {
+    if (!in.weights.empty() && in.weights.size() != in.points.size())
+        return failed(FitKind::kBSpline, "weights and points differ in number");
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        if (!finite(in.points[i]) || (!in.weights.empty() && !(in.weights[i] >= 0)))
+            return failed(FitKind::kBSpline, "a point or weight is not a finite number");
+    }
+    bool capped = false;
+    return fit_helical(in, tolerance, capped);
 }
 
 FitResult fit_bspline(const FitInput& in, double tolerance) {
