@@ -1167,6 +1167,8 @@ std::size_t free_parameters(const Surface& s) {
     if (!s.bspline) return 0;
     const auto nu = static_cast<std::size_t>(s.bspline->num_u),
                nv = static_cast<std::size_t>(s.bspline->num_v);
+    // A helical sweep: its profile's poles, the axis (4) and the pitch.
+    if (s.bspline->helical) return 2 * nu + 5;
     return s.bspline->extruded ? 2 * nu + 2 : nu * nv;
 }
 
@@ -2351,6 +2353,80 @@ std::vector<std::uint32_t> grow_loose(Context& c, std::vector<Draft>& drafts) {
     return grown;
 }
 
+/// Thread flanks: a free-form region whose facets fit one helical sweep (fit_helical(); half a
+/// turn of a flank fixes its screw motion) takes its neighbours, of any kind, whose facets lie on
+/// that sweep (chords_agree()) while the sweep refitted to them all stays within the chordal
+/// deflection: the flank's other pieces along its helix, a B-spline patch, cone and torus pieces
+/// and one-facet planes each, become one region. Kept when the sweep pays as an extrusion does
+/// (extrusion_pays(): within kFreeformRms x the pieces' RMS, in fewer numbers). Seeds are
+/// taken largest first. Returns the regions that grew.
+std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts) {
+    std::vector<std::uint32_t> grown;
+    const std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
+    for (const auto& [a, b] : adjacent_pairs(c, region, false))
+        nbrs[a].push_back(b), nbrs[b].push_back(a);
+    const auto open = [&](std::uint32_t r) {
+        return drafts[r].alive && drafts[r].surface_index < 0 && !drafts[r].faces.empty();
+    };
+    std::vector<std::uint32_t> seeds;
+    for (std::uint32_t r = 0; r < drafts.size(); ++r) {
+        const Surface& s = drafts[r].surface;
+        if (open(r) && s.kind == FitKind::kBSpline && s.bspline && !s.bspline->extruded)
+            seeds.push_back(r);
+    }
+    std::stable_sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return drafts[a].faces.size() > drafts[b].faces.size();
+    });
+    std::vector<std::uint32_t> mark(drafts.size(), kNone);
+    const auto helix_of = [&](std::span<const std::uint32_t> faces) {
+        PointSet ps;
+        c.gatherers.local().gather(c.m, c.fd, faces, ps);
+        FitResult r = fit_helical(FitInput{ps.points, ps.normals, {}}, c.sag);
+        if (r.ok && !(r.max <= c.sag)) r.ok = false;
+        return r;
+    };
+    for (const std::uint32_t s : seeds) {
+        if (!open(s)) continue;
+        FitResult best = helix_of(drafts[s].faces);
+        if (!best.ok) continue;
+        std::vector<std::uint32_t> group{s}, faces = drafts[s].faces, frontier;
+        mark[s] = s;
+        const auto reach = [&](std::uint32_t r) {
+            for (const std::uint32_t n : nbrs[r]) {
+                if (mark[n] == s || !open(n)) continue;
+                mark[n] = s;
+                frontier.push_back(n);
+            }
+        };
+        reach(s);
+        while (!frontier.empty()) {
+            // The smallest index first: the same order whatever the threads.
+            const auto it = std::min_element(frontier.begin(), frontier.end());
+            const std::uint32_t n = *it;
+            frontier.erase(it);
+            std::vector<std::uint32_t> more = faces;
+            more.insert(more.end(), drafts[n].faces.begin(), drafts[n].faces.end());
+            FitResult r = helix_of(more);
+            if (!r.ok || !chords_agree(c, r.surface, more)) continue;
+            group.push_back(n);
+            faces = std::move(more);
+            best = std::move(r);
+            reach(n);
+        }
+        if (group.size() < 2 || !extrusion_pays(best, measure_pieces(c, drafts, group))) continue;
+        std::sort(faces.begin(), faces.end());
+        drafts[s].faces = std::move(faces);
+        drafts[s].surface = best.surface;
+        for (std::size_t i = 1; i < group.size(); ++i) {
+            drafts[group[i]].alive = false;
+            drafts[group[i]].faces.clear();
+        }
+        grown.push_back(s);
+    }
+    return grown;
+}
+
 /// Regions numbered in the order of their first face; faces labelled; final fits. With
 /// `loose`, free-form faces in loose pieces are merged on the way (merge_loose_pieces()).
 /// Returns the noise (noise_level()) of the regions before that: a free-form face merged from
@@ -2372,6 +2448,7 @@ double finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRec
         result.freeform_groups += merged.size();
         for (const std::uint32_t g : merge_chords(c, drafts)) merged.push_back(g);
         for (const std::uint32_t g : grow_loose(c, drafts)) merged.push_back(g);
+        for (const std::uint32_t g : merge_helical(c, drafts)) merged.push_back(g);
         // The groups' new surfaces may take the small regions left between them and their
         // neighbours (one-facet planes along a free-form face's seams), as the regions before
         // the final fits took theirs; a region that took or gave facets is fitted again.
