@@ -791,6 +791,15 @@ TEST(FitHelical, ThreadFlankIsOneHelicalSweep) {
     test::Rng rng(41);
     const Patch bump = freeform_patch(rng, 2000);
     EXPECT_FALSE(fit_helical(FitInput{bump.points, bump.normals, {}}, 1e-3 * bump.size).ok);
+    // Nor is a plane (only turns about its normal and slides along it keep it in place, no
+    // helix), nor too few points, nor points without normals: refused with a reason.
+    const Patch flat = plane_patch(rng, 500);
+    const FitResult on_plane = fit_helical(FitInput{flat.points, flat.normals, {}}, 1e-3);
+    EXPECT_FALSE(on_plane.ok);
+    EXPECT_FALSE(on_plane.failure.empty());
+    EXPECT_FALSE(
+        fit_helical(FitInput{std::span(points).first(8), std::span(normals).first(8), {}}, tol).ok);
+    EXPECT_FALSE(fit_helical(FitInput{points, {}, {}}, tol).ok);
 }
 
 TEST(FitSnap, NearlyRoundValuesBecomeRoundAndTrueOnesStay) {

@@ -2234,6 +2234,10 @@ FitResult fit_helical(const FitInput& in, double tolerance, bool& capped) {
         a0 = std::min(a0, angle[i]), a1 = std::max(a1, angle[i]);
     }
     if (!(a1 > a0)) return fail;
+    if (!((a1 - a0) / kHelixSpanAngle <= kHelixMaxSpans)) {
+        fail.failure = "the helix turns too often for a B-spline of the size limit";
+        return fail;
+    }
     // The motion refined on the points' distances, and the points turned back along it.
     refine_screw(in, tolerance, angle, e1, e2, scale, axis, origin, pitch);
     e1 = normalized(e1 - dot(e1, axis) * axis), e2 = cross(axis, e1);
@@ -2253,7 +2257,12 @@ FitResult fit_helical(const FitInput& in, double tolerance, bool& capped) {
     // The unit circle's direction d(phi) = cos phi e1 + sin phi e2 over [a0, a1] as a cubic
     // B-spline (least squares on samples along each span), its poles' angles for the climb at
     // the Greville abscissae (where a B-spline reproduces a linear function exactly).
-    int spans = std::max(1, static_cast<int>(std::ceil((a1 - a0) / kHelixSpanAngle)));
+    const double span_count = std::ceil((a1 - a0) / kHelixSpanAngle);
+    if (!(span_count <= kHelixMaxSpans)) {
+        fail.failure = "the helix turns too often for a B-spline of the size limit";
+        return fail;
+    }
+    int spans = std::max(1, static_cast<int>(span_count));
     std::vector<double> dc, ds, phi;
     double circle_err = 0;
     for (;;) {
