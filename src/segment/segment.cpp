@@ -2362,10 +2362,6 @@ std::vector<std::uint32_t> grow_loose(Context& c, std::vector<Draft>& drafts) {
 /// taken largest first. Returns the regions that grew.
 std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts) {
     std::vector<std::uint32_t> grown;
-    const std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
-    std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
-    for (const auto& [a, b] : adjacent_pairs(c, region, false))
-        nbrs[a].push_back(b), nbrs[b].push_back(a);
     const auto open = [&](std::uint32_t r) {
         return drafts[r].alive && drafts[r].surface_index < 0 && !drafts[r].faces.empty();
     };
@@ -2375,9 +2371,15 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
         if (open(r) && s.kind == FitKind::kBSpline && s.bspline && !s.bspline->extruded)
             seeds.push_back(r);
     }
+    // No B-spline, no thread: the region adjacency (a pass over every facet) is not needed.
+    if (seeds.empty()) return grown;
     std::stable_sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
         return drafts[a].faces.size() > drafts[b].faces.size();
     });
+    const std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
+    for (const auto& [a, b] : adjacent_pairs(c, region, false))
+        nbrs[a].push_back(b), nbrs[b].push_back(a);
     std::vector<std::uint32_t> mark(drafts.size(), kNone);
     const auto helix_of = [&](std::span<const std::uint32_t> faces) {
         PointSet ps;
