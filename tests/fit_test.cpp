@@ -735,71 +735,79 @@ TEST(FitBSpline, ExtrusionFollowsATightBend) {
 
 // A thread's flank: a curved profile (0.6 mm deep, leaning about 30 degrees) swept along a helix
 // of 1 mm pitch over eight turns about a tilted axis — no height field, no extrusion — sampled
-// along the helix as a mesh of the thread would be (five rows: the profile's points coincide
-// turn after turn). One helical sweep describes it: a profile of a few poles, not a net of
-// hundreds; the axis and the pitch are found, not given.
+// along the helix in five rows that wander across it a little from sample to sample, as a
+// mesh's vertices do, right- and left-handed. One helical sweep describes it: a profile of a few
+// poles, not a net of hundreds; the axis and the pitch are found, not given.
 TEST(FitHelical, ThreadFlankIsOneHelicalSweep) {
     const Vec3 a = normalized(Vec3{0.2, 0.1, 1});
     Vec3 e1 = normalized(cross(a, Vec3{1, 0, 0}));
     const Vec3 e2 = cross(a, e1);
     const Vec3 origin{3, -1, 2};
-    const double pitch = 1.0 / (2 * std::numbers::pi);  // 1 mm a turn
-    const auto flank = [&](double phi, double t, Vec3* normal) {
-        const double r = 2.4 + 0.6 * t, h = 0.35 * t + 0.05 * t * t;
-        const Vec3 d = std::cos(phi) * e1 + std::sin(phi) * e2;
-        const Vec3 dd = -std::sin(phi) * e1 + std::cos(phi) * e2;
-        if (normal) *normal = normalized(cross(r * dd + pitch * a, 0.6 * d + (0.35 + 0.1 * t) * a));
-        return origin + r * d + (h + pitch * phi) * a;
-    };
-    std::vector<Vec3> points, normals;
-    for (int k = 0; k <= 8 * 48; ++k) {
-        const double phi = 2 * std::numbers::pi * k / 48;
-        for (int j = 0; j <= 4; ++j) {
-            Vec3 n;
-            points.push_back(flank(phi, j / 4.0, &n));
-            normals.push_back(n);
+    for (const double hand : {1.0, -1.0}) {
+        SCOPED_TRACE(hand > 0 ? "right-handed" : "left-handed");
+        const double pitch = hand / (2 * std::numbers::pi);  // 1 mm a turn
+        const auto flank = [&](double phi, double t, Vec3* normal) {
+            const double r = 2.4 + 0.6 * t, h = 0.35 * t + 0.05 * t * t;
+            const Vec3 d = std::cos(phi) * e1 + std::sin(phi) * e2;
+            const Vec3 dd = -std::sin(phi) * e1 + std::cos(phi) * e2;
+            if (normal)
+                *normal = normalized(cross(r * dd + pitch * a, 0.6 * d + (0.35 + 0.1 * t) * a));
+            return origin + r * d + (h + pitch * phi) * a;
+        };
+        std::vector<Vec3> points, normals;
+        for (int k = 0; k <= 8 * 48; ++k) {
+            const double phi = 2 * std::numbers::pi * k / 48;
+            for (int j = 0; j <= 4; ++j) {
+                Vec3 n;
+                const double t = std::clamp((j + 0.3 * std::sin(1.7 * k + j)) / 4, 0.0, 1.0);
+                points.push_back(flank(phi, t, &n));
+                normals.push_back(n);
+            }
         }
+        const double tol = 1e-3;
+        const FitResult r = fit_helical(FitInput{points, normals, {}}, tol);
+        ASSERT_TRUE(r.ok) << r.failure;
+        ASSERT_TRUE(r.surface.bspline);
+        const BSplineSurface& b = *r.surface.bspline;
+        EXPECT_TRUE(b.helical);
+        EXPECT_FALSE(b.extruded);
+        EXPECT_LE(r.max, tol);
+        EXPECT_EQ(b.num_u, 4);  // the profile's poles: a cubic takes its parabola
+        // The axis, a point on it and the pitch (its sign is the hand, whichever way the axis
+        // points).
+        EXPECT_GE(std::fabs(dot(b.helix.axis, a)), 1 - 1e-9);
+        EXPECT_LE(norm(cross(b.helix.origin - origin, a)), 1e-6);
+        EXPECT_NEAR(b.helix.pitch, pitch, 1e-7);
+        // Points of the flank between the samples, on every turn.
+        for (int k = 0; k < 200; ++k) {
+            const double phi = 16 * std::numbers::pi * (0.003 + 0.994 * k / 200.0);
+            const Vec3 p = flank(phi, 0.1 + 0.8 * ((k * 37) % 100) / 100.0, nullptr);
+            EXPECT_LE(distance(r.surface, p), 2 * tol) << k;
+        }
+        // A point half a pitch off the flank along the axis is far from it (the next turn is
+        // not the surface).
+        EXPECT_GE(distance(r.surface, flank(9.0, 0.5, nullptr) + 0.5 * a), 0.1);
+        // Half a turn of it is enough to find the same motion (a seed of merge_helical()).
+        const std::size_t half = 5 * 25;
+        const FitResult part = fit_helical(
+            FitInput{std::span(points).first(half), std::span(normals).first(half), {}}, tol);
+        ASSERT_TRUE(part.ok) << part.failure;
+        EXPECT_GE(std::fabs(dot(part.surface.bspline->helix.axis, a)), 1 - 1e-9);
+        EXPECT_LE(norm(cross(part.surface.bspline->helix.origin - origin, a)), 1e-6);
+        EXPECT_NEAR(part.surface.bspline->helix.pitch, pitch, 1e-7);
+        // Too few points, or points without normals, are refused.
+        EXPECT_FALSE(
+            fit_helical(FitInput{std::span(points).first(8), std::span(normals).first(8), {}}, tol)
+                .ok);
+        EXPECT_FALSE(fit_helical(FitInput{points, {}, {}}, tol).ok);
     }
-    const double tol = 1e-3;
-    const FitResult r = fit_helical(FitInput{points, normals, {}}, tol);
-    ASSERT_TRUE(r.ok) << r.failure;
-    ASSERT_TRUE(r.surface.bspline);
-    EXPECT_TRUE(r.surface.bspline->helical);
-    EXPECT_FALSE(r.surface.bspline->extruded);
-    EXPECT_LE(r.max, tol);
-    EXPECT_LE(r.surface.bspline->num_u, 8);  // the profile's poles
-    // The axis and a point on it.
-    EXPECT_GE(std::fabs(dot(r.surface.axis, a)), 1 - 1e-6);
-    EXPECT_LE(norm(cross(r.surface.point - origin, a)), 1e-4);
-    // Points of the flank between the samples, on every turn.
-    for (int k = 0; k < 200; ++k) {
-        const double phi = 16 * std::numbers::pi * (0.003 + 0.994 * k / 200.0);
-        const Vec3 p = flank(phi, 0.1 + 0.8 * ((k * 37) % 100) / 100.0, nullptr);
-        EXPECT_LE(distance(r.surface, p), 2 * tol) << k;
-    }
-    // A point half a pitch off the flank along the axis is far from it (the next turn is not
-    // the surface).
-    EXPECT_GE(distance(r.surface, flank(9.0, 0.5, nullptr) + 0.5 * a), 0.1);
-    // Half a turn of it is enough to find the same motion (a seed of merge_helical()): points
-    // of the next turn lie on the sweep fitted to it.
-    const std::size_t half = 5 * 25;
-    const FitResult part = fit_helical(
-        FitInput{std::span(points).first(half), std::span(normals).first(half), {}}, tol);
-    ASSERT_TRUE(part.ok) << part.failure;
-    EXPECT_GE(std::fabs(dot(part.surface.axis, a)), 1 - 1e-6);
-    // A free-form bump swept by no screw motion is none.
+    // A free-form bump swept by no screw motion is none; nor is a plane (only turns about its
+    // normal and slides along it keep it in place, no helix).
     test::Rng rng(41);
     const Patch bump = freeform_patch(rng, 2000);
     EXPECT_FALSE(fit_helical(FitInput{bump.points, bump.normals, {}}, 1e-3 * bump.size).ok);
-    // Nor is a plane (only turns about its normal and slides along it keep it in place, no
-    // helix), nor too few points, nor points without normals: refused with a reason.
     const Patch flat = plane_patch(rng, 500);
-    const FitResult on_plane = fit_helical(FitInput{flat.points, flat.normals, {}}, 1e-3);
-    EXPECT_FALSE(on_plane.ok);
-    EXPECT_FALSE(on_plane.failure.empty());
-    EXPECT_FALSE(
-        fit_helical(FitInput{std::span(points).first(8), std::span(normals).first(8), {}}, tol).ok);
-    EXPECT_FALSE(fit_helical(FitInput{points, {}, {}}, tol).ok);
+    EXPECT_FALSE(fit_helical(FitInput{flat.points, flat.normals, {}}, 1e-3).ok);
 }
 
 TEST(FitSnap, NearlyRoundValuesBecomeRoundAndTrueOnesStay) {

@@ -159,10 +159,11 @@ FitResult residuals(const Surface& surface, const FitInput& input);
 /// to within 1e-4 of the points' extent (see fit_bspline()). Never throws.
 FitResult fit(FitKind kind, const FitInput& input);
 
-/// A helical sweep only (what fit_bspline() tries after a linear extrusion): a planar profile
-/// swept along a helix about an axis found from the normals and refined on the points — a
-/// thread's flank. ok false when the points are no such sweep within `tolerance`; the surface
-/// is a B-spline with `helical` set.
+/// A helical sweep: a planar profile swept along a helix about an axis found from the normals
+/// and refined on the points — a thread's flank. fit_bspline() does not try it (on a quarter
+/// turn a wrong motion still fits); segmentation asks for it where a region is a B-spline. ok false
+/// when the points are no such sweep within `tolerance`; the surface is a B-spline with `helical`
+/// set.
 FitResult fit_helical(const FitInput& input, double tolerance);
 
 /// A cubic B-spline surface. First as a linear extrusion when the normals are all normal to one

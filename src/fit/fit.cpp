@@ -1289,20 +1289,26 @@ void coarse_start(const BSplineSurface& b, Vec3 p, double& u, double& v) {
     start_grid(b, gu, gv);
     const bool cached = b.starts.size() == static_cast<std::size_t>((gu + 1) * (gv + 1));
     int bi = 0, bj = 0;
-    int j0 = 0, j1 = gv;
+    // Rows [j0, j1], and on a helix [k0, k1] too: the turns below and above the point's height
+    // (one near half a pitch from the profile's is as near the one as the other).
+    int j0 = 0, j1 = gv, k0 = 1, k1 = 0;
     const BSplineSurface::Helix& hx = b.helix;
     if (b.helical && hx.a1 > hx.a0 && hx.pitch != 0 && gv > 0) {
         const Vec3 d = p - hx.origin;
         const double z = dot(d, hx.axis);
         const double th = std::atan2(dot(d, cross(hx.axis, hx.x)), dot(d, hx.x));
-        const double turn = std::round((z - hx.pitch * th - hx.h) / (2 * kPi * hx.pitch));
-        const double at = std::clamp((th + 2 * kPi * turn - hx.a0) / (hx.a1 - hx.a0), 0.0, 1.0);
-        if (std::isfinite(at)) {
-            const int j = static_cast<int>(std::lround(at * gv));
-            j0 = std::max(0, j - 1), j1 = std::min(gv, j + 1);
+        const double turns = (z - hx.pitch * th - hx.h) / (2 * kPi * hx.pitch);
+        const auto row = [&](double turn) {
+            const double at = std::clamp((th + 2 * kPi * turn - hx.a0) / (hx.a1 - hx.a0), 0.0, 1.0);
+            return std::isfinite(at) ? static_cast<int>(std::lround(at * gv)) : -1;
+        };
+        const int below = row(std::floor(turns)), above = row(std::ceil(turns));
+        if (below >= 0 && above >= 0) {
+            j0 = std::max(0, below - 1), j1 = std::min(gv, below + 1);
+            k0 = std::max(0, above - 1), k1 = std::min(gv, above + 1);
         }
     }
-    for (int j = j0; j <= j1; ++j) {
+    const auto scan = [&](int j) {
         for (int i = 0; i <= gu; ++i) {
             const Vec3 q = (cached ? b.starts[static_cast<std::size_t>(i + (gu + 1) * j)]
                                    : start_point(b, gu, gv, i, j)) -
@@ -1310,7 +1316,10 @@ void coarse_start(const BSplineSurface& b, Vec3 p, double& u, double& v) {
             const double d2 = dot(q, q);
             if (d2 < best) best = d2, bi = i, bj = j;
         }
-    }
+    };
+    for (int j = j0; j <= j1; ++j) scan(j);
+    for (int j = std::max(k0, j1 + 1); j <= k1; ++j) scan(j);  // rows not scanned above
+    for (int j = k0; j <= std::min(k1, j0 - 1); ++j) scan(j);
     start_params(gu, gv, bi, bj, u, v);
 }
 

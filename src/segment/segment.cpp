@@ -1869,9 +1869,14 @@ Region final_region(Context& c, const Draft& d, std::span<const SurfaceRecord> r
     } else if (d.surface.kind == FitKind::kBSpline) {
         // The surface merge_freeform() fitted while it holds the region's vertices as it did
         // (refining the borders moves a few facets); refitted otherwise.
+        // A thread's flank (merge_helical()) is no height field or extrusion: refitted as the
+        // helical sweep it is.
         out.fit = residuals(d.surface, in);
         if (!(out.fit.max <= c.sag)) {
-            FitResult again = fit_bspline(FitInput{ps.points, ps.normals, {}}, c.sag);
+            const FitInput unweighted{ps.points, ps.normals, {}};
+            FitResult again = d.surface.bspline && d.surface.bspline->helical
+                                  ? fit_helical(unweighted, c.sag)
+                                  : fit_bspline(unweighted, c.sag);
             if (again.ok) out.fit = std::move(again);
         }
     } else {
@@ -2354,12 +2359,12 @@ std::vector<std::uint32_t> grow_loose(Context& c, std::vector<Draft>& drafts) {
 }
 
 /// Thread flanks: a free-form region whose facets fit one helical sweep (fit_helical(); half a
-/// turn of a flank fixes its screw motion) takes its neighbours, of any kind, whose facets lie on
-/// that sweep (chords_agree()) while the sweep refitted to them all stays within the chordal
-/// deflection: the flank's other pieces along its helix, a B-spline patch, cone and torus pieces
-/// and one-facet planes each, become one region. Kept when the sweep pays as an extrusion does
-/// (extrusion_pays(): within kFreeformRms x the pieces' RMS, in fewer numbers). Seeds are
-/// taken largest first. Returns the regions that grew.
+/// turn of a flank fixes its screw motion) takes its smoothly joined neighbours, of any kind,
+/// whose facets lie on that sweep (chords_agree()) while the sweep refitted to them all stays
+/// within the chordal deflection: the flank's other pieces along its helix, a B-spline patch, cone
+/// and torus pieces and one-facet planes each, become one region. Kept when the sweep pays as an
+/// extrusion does (extrusion_pays(): within kFreeformRms x the pieces' RMS, in fewer numbers).
+/// Seeds are taken largest first. Returns the regions that grew.
 std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts) {
     std::vector<std::uint32_t> grown;
     const auto open = [&](std::uint32_t r) {
@@ -2378,7 +2383,9 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
     });
     const std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
     std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
-    for (const auto& [a, b] : adjacent_pairs(c, region, false))
+    // Along smooth edges only: a crease (the flank's edge with the thread's crest or root, a
+    // coaxial cylinder that every screw motion about the axis keeps in place) is a face's edge.
+    for (const auto& [a, b] : adjacent_pairs(c, region, true))
         nbrs[a].push_back(b), nbrs[b].push_back(a);
     std::vector<std::uint32_t> mark(drafts.size(), kNone);
     const auto helix_of = [&](std::span<const std::uint32_t> faces) {
@@ -2388,8 +2395,9 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
         if (r.ok && !(r.max <= c.sag)) r.ok = false;
         return r;
     };
+    std::vector<std::uint8_t> tried(drafts.size(), 0);
     for (const std::uint32_t s : seeds) {
-        if (!open(s)) continue;
+        if (!open(s) || tried[s]) continue;
         FitResult best = helix_of(drafts[s].faces);
         if (!best.ok) continue;
         std::vector<std::uint32_t> group{s}, faces = drafts[s].faces, frontier;
@@ -2416,7 +2424,11 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
             best = std::move(r);
             reach(n);
         }
-        if (group.size() < 2 || !extrusion_pays(best, measure_pieces(c, drafts, group))) continue;
+        if (group.size() < 2 || !extrusion_pays(best, measure_pieces(c, drafts, group))) {
+            // Its pieces seed no group of their own: one would grow into the same.
+            for (const std::uint32_t p : group) tried[p] = 1;
+            continue;
+        }
         std::sort(faces.begin(), faces.end());
         drafts[s].faces = std::move(faces);
         drafts[s].surface = best.surface;
