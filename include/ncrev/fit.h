@@ -48,7 +48,9 @@ const char* to_string(FitKind kind);
 ///   swept along the unit `sweep` (not in that plane): an elliptic cylinder along `sweep`;
 /// - swept_torus: the torus (`point`, `axis`, `radius` R, `minor_radius` r) swept along
 ///   `sweep`: the points at distance r from the shear cylinder of radius R;
-/// - bspline: `bspline` (below); `point` and `axis` the mean plane it is a height field over.
+/// - bspline: `bspline` (below); `point` and `axis` the mean plane it is a height field over
+///   (a net), its centroid and direction (an extrusion), or a point on its axis and the axis
+///   (a helical sweep).
 /// The orientation of `axis` carries no meaning except for cones.
 struct BSplineSurface;
 struct Surface {
