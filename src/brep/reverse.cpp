@@ -302,8 +302,12 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     stage("refit", [&] {
         std::vector<std::vector<Vec3>> points(sr.regions.size()), middles(sr.regions.size());
         std::vector<std::vector<std::uint8_t>> seen(sr.regions.size());
+        // Not a helical sweep (a thread's flank, docs/fitting.md): segmentation fitted it to
+        // the vertices and their normals already, and no net over one plane, the refit's, can
+        // follow a flank round several turns.
         for (std::size_t r = 0; r < sr.regions.size(); ++r) {
-            if (sr.regions[r].fit.ok && sr.regions[r].fit.surface.kind == FitKind::kBSpline) {
+            const FitResult& fr = sr.regions[r].fit;
+            if (fr.ok && fr.surface.kind == FitKind::kBSpline && !fr.surface.bspline->helical) {
                 seen[r].assign(mesh.num_vertices(), 0);
             }
         }

@@ -1721,7 +1721,7 @@ bool profile_parameters(const std::vector<double>& x, const std::vector<double>&
     return true;
 }
 
-/// A planar profile swept along a rigid motion (fit_extrusion(), fit_helical()): each point's
+/// A planar profile swept along a rigid motion (fit_extrusion(), helical_sweep()): each point's
 /// coordinates (x, y) in the profile's plane and its normal's components there (ux, uy), and
 /// the B-spline surface of the profile whose poles are (px, py) in that plane, with `slack`
 /// how far that surface may be from the exact sweep of the profile (added to every residual).
@@ -1990,7 +1990,7 @@ constexpr double kHelixSpanAngle = kPi / 8;
 constexpr double kHelixSlack = 1e-3;
 constexpr int kHelixMaxSpans = 2048;
 
-/// The screw motion of fit_helical() refined on the points' distances: its normals' motion is
+/// The screw motion of helical_sweep() refined on the points' distances: its normals' motion is
 /// off by the mesh's normals' own error (a flank of an M6 thread meshed at 0.02 mm: an axis
 /// 0.0003 rad and 0.002 mm off, a profile of 21 poles to reach the deflection, where the true
 /// motion leaves a straight line within 1e-5 mm). Levenberg-Marquardt on the motion (the axis'
@@ -2123,8 +2123,9 @@ void refine_screw(const FitInput& in, double tolerance, const std::vector<double
             std::array<double, kMotion> mm = m;
             for (int k = 0; k < kMotion; ++k) mm[static_cast<std::size_t>(k)] += delta(2 * np + k);
             const Eigen::VectorXd pl = poles + delta.head(2 * np);
+            // (res, nx and ny are the tried state's now; the next try or the accepted one
+            // overwrites them, and a round with no better try ends the refinement.)
             std::vector<double> par = s;
-            const std::vector<double> keep_res = res, keep_nx = nx, keep_ny = ny;
             const double now = residuals(mm, pl, par);
             if (now < rms) {
                 better = true;
@@ -2132,8 +2133,6 @@ void refine_screw(const FitInput& in, double tolerance, const std::vector<double
                 m = mm, poles = pl, s = std::move(par), rms = now;
                 damping = std::max(damping / 100, 1e-12);
                 if (small_gain) round = kRefineRounds;
-            } else {
-                res = keep_res, nx = keep_nx, ny = keep_ny;
             }
         }
         if (!better) break;
@@ -2160,9 +2159,8 @@ void refine_screw(const FitInput& in, double tolerance, const std::vector<double
 /// kHelixSlack x the tolerance, so exactly helical across and within that along. ok false
 /// when the normals fit no screw motion, the motion does not turn or climb, the profile is not
 /// one open curve in one turn, or no profile of up to kBSplineMaxPoles poles (or
-/// `max_profile_poles`: then `capped`) reaches `tolerance`.
-FitResult fit_helical(const FitInput& in, double tolerance, bool& capped) {
-    capped = false;
+/// `max_profile_poles`) reaches `tolerance`. The points are finite (fit_helical() checks).
+FitResult helical_sweep(const FitInput& in, double tolerance) {
     FitResult fail = failed(FitKind::kBSpline, "not a helical sweep");
     const std::size_t n = in.points.size();
     if (in.normals.size() != n || n < 16 || !(tolerance > 0)) return fail;
@@ -2208,19 +2206,15 @@ FitResult fit_helical(const FitInput& in, double tolerance, bool& capped) {
     }
     Vec3 e1, e2;
     frame(axis, e1, e2);
-    std::vector<double> r(n), h(n), angle(n), ux(n), uy(n), wrapped(n);
-    double r_max = 0;
+    // Each point's angle about the axis and height less the pitch's share of it (its place in
+    // the profile's half-plane once the motion is refined, below), the height wrapped into
+    // one pitch.
+    std::vector<double> h(n), angle(n), wrapped(n);
     for (std::size_t i = 0; i < n; ++i) {
         const Vec3 d = in.points[i] - origin;
-        const double z = dot(d, axis), px = dot(d, e1), py = dot(d, e2);
-        r[i] = std::hypot(px, py);
-        if (!(r[i] > 0)) return fail;
-        angle[i] = std::atan2(py, px);
-        h[i] = z - pitch * angle[i];
-        const Vec3 radial = (px * e1 + py * e2) / r[i];
-        ux[i] = dot(in.normals[i], radial), uy[i] = dot(in.normals[i], axis);
+        angle[i] = std::atan2(dot(d, e2), dot(d, e1));
+        h[i] = dot(d, axis) - pitch * angle[i];
         wrapped[i] = h[i] - period * std::floor(h[i] / period);
-        r_max = std::max(r_max, r[i]);
     }
     // The profile's turn starts after the widest gap of the heights wrapped into one pitch.
     std::vector<double> sorted = wrapped;
@@ -2250,7 +2244,9 @@ FitResult fit_helical(const FitInput& in, double tolerance, bool& capped) {
     // The motion refined on the points' distances, and the points turned back along it.
     refine_screw(in, tolerance, angle, e1, e2, scale, axis, origin, pitch);
     e1 = normalized(e1 - dot(e1, axis) * axis), e2 = cross(axis, e1);
-    a0 = std::numeric_limits<double>::infinity(), a1 = -a0, r_max = 0;
+    std::vector<double> r(n), ux(n), uy(n);
+    double r_max = 0;
+    a0 = std::numeric_limits<double>::infinity(), a1 = -a0;
     for (std::size_t i = 0; i < n; ++i) {
         const Vec3 d = in.points[i] - origin;
         const double px = dot(d, e1), py = dot(d, e2);
@@ -2274,11 +2270,7 @@ FitResult fit_helical(const FitInput& in, double tolerance, bool& capped) {
     int spans = std::max(1, static_cast<int>(span_count));
     std::vector<double> dc, ds, phi;
     double circle_err = 0;
-    for (;;) {
-        if (spans > kHelixMaxSpans) {
-            fail.failure = "the helix turns too often for a B-spline of the size limit";
-            return fail;
-        }
+    for (;; spans *= 2) {
         const int nv = spans + 3;
         constexpr int kSamples = 8;  // per span, for the fit; twice as many for the check
         // Banded (each sample touches 4 poles): a sparse factorization, as a long thread has
@@ -2312,22 +2304,22 @@ FitResult fit_helical(const FitInput& in, double tolerance, bool& capped) {
             for (int a = 0; a <= 3; ++a) x += N[a] * pc(sp + a), y += N[a] * ps(sp + a);
             circle_err = std::max(circle_err, std::hypot(x - std::cos(f), y - std::sin(f)));
         }
-        if (circle_err * r_max <= kHelixSlack * tolerance || spans * 2 > kHelixMaxSpans) {
-            if (circle_err * r_max > kHelixSlack * tolerance) {
+        if (circle_err * r_max > kHelixSlack * tolerance) {
+            if (spans * 2 > kHelixMaxSpans) {
                 fail.failure = "the helix turns too often for a B-spline of the size limit";
                 return fail;
             }
-            dc.assign(pc.data(), pc.data() + nv);
-            ds.assign(ps.data(), ps.data() + nv);
-            const std::vector<double> knots = cubic_knots(nv);
-            phi.resize(static_cast<std::size_t>(nv));
-            for (int b = 0; b < nv; ++b) {
-                const auto k = static_cast<std::size_t>(b);
-                phi[k] = a0 + (a1 - a0) * (knots[k + 1] + knots[k + 2] + knots[k + 3]) / 3;
-            }
-            break;
+            continue;
         }
-        spans *= 2;
+        dc.assign(pc.data(), pc.data() + nv);
+        ds.assign(ps.data(), ps.data() + nv);
+        const std::vector<double> knots = cubic_knots(nv);
+        phi.resize(static_cast<std::size_t>(nv));
+        for (int b = 0; b < nv; ++b) {
+            const auto k = static_cast<std::size_t>(b);
+            phi[k] = a0 + (a1 - a0) * (knots[k + 1] + knots[k + 2] + knots[k + 3]) / 3;
+        }
+        break;
     }
     double h_lo = std::numeric_limits<double>::infinity(), h_hi = -h_lo;
     for (const double hh : h) h_lo = std::min(h_lo, hh), h_hi = std::max(h_hi, hh);
@@ -2357,6 +2349,7 @@ FitResult fit_helical(const FitInput& in, double tolerance, bool& capped) {
         return bs;
     };
     fail.failure = "the points turned back along their helices are not one open profile";
+    bool capped = false;  // a profile past max_profile_poles fails like any other here
     return fit_profile_sweep(in, tolerance, capped, sweep, std::move(fail));
 }
 
@@ -2631,18 +2624,11 @@ CommonPoint common_point(std::span<const Surface> surfaces, Vec3 start) {
     return out;
 }
 
-FitResult fit_helical(const FitInput& in, double tolerance) {
-    if (!in.weights.empty() && in.weights.size() != in.points.size())
-        return failed(FitKind::kBSpline, "weights and points differ in number");
-    for (std::size_t i = 0; i < in.points.size(); ++i) {
-        if (!finite(in.points[i]) || (!in.weights.empty() && !(in.weights[i] >= 0)))
-            return failed(FitKind::kBSpline, "a point or weight is not a finite number");
-    }
-    bool capped = false;
-    return fit_helical(in, tolerance, capped);
-}
+namespace {
 
-FitResult fit_bspline(const FitInput& in, double tolerance) {
+/// Why `in` cannot be fitted as a B-spline at all (weights that do not match the points, too
+/// few points, a point or weight not a finite number), or nothing.
+std::optional<FitResult> unfit_for_bspline(const FitInput& in) {
     if (!in.weights.empty() && in.weights.size() != in.points.size()) {
         return failed(FitKind::kBSpline, "weights and points differ in number");
     }
@@ -2652,6 +2638,18 @@ FitResult fit_bspline(const FitInput& in, double tolerance) {
             return failed(FitKind::kBSpline, "a point or weight is not a finite number");
         }
     }
+    return std::nullopt;
+}
+
+}  // namespace
+
+FitResult fit_helical(const FitInput& in, double tolerance) {
+    if (std::optional<FitResult> bad = unfit_for_bspline(in)) return *bad;
+    return helical_sweep(in, tolerance);
+}
+
+FitResult fit_bspline(const FitInput& in, double tolerance) {
+    if (std::optional<FitResult> bad = unfit_for_bspline(in)) return *bad;
     // A wall extruded along one direction first: its net is a profile's, not a grid's.
     bool capped = false;
     FitResult extrusion = fit_extrusion(in, tolerance, capped);

