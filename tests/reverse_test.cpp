@@ -914,6 +914,47 @@ FaceMatch match_faces(const SamplePart& part, bool list = false) {
     return fm;
 }
 
+// The M6 screw's flanks (true faces of 1000-1100 facets over seven turns) each ended in a
+// B-spline patch of 93-97 facets that also held a tenth of the thread's faded end: no one
+// helical sweep fits that patch, and 8 % of each flank stayed out of its region. The flank's
+// region now takes the patch's facets that lie on its sweep unbounded along its helix
+// (facets_along_helix()); the rest stays with the faded end.
+TEST(ReverseSurfaces, AThreadFlankIsOneRegionToItsEnd) {
+    const auto path = corpus_step_dir() / "build123d_M6-1x12-countersunk-screw.step";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus at " << path;
+    const SamplePart part = corpus_part(path);
+    const Result<BuildResult> built = build_mesh(part.mesh);
+    ASSERT_TRUE(built.ok());
+    const Mesh& mesh = built.value().mesh;
+    const Result<SegmentResult> seg = segment(mesh);
+    ASSERT_TRUE(seg.ok());
+    std::map<std::int64_t, std::map<std::int32_t, double>> by_region;  // true face -> areas
+    std::map<std::int64_t, std::size_t> facets;
+    for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+        const FaceId ff(static_cast<std::uint32_t>(f));
+        by_region[mesh.cuts()[f]][seg.value().region[ff]] += mesh.face_area(ff);
+        ++facets[mesh.cuts()[f]];
+    }
+    // Each large free-form face of the original (the flanks, and the crest, a cylinder written
+    // as a B-spline) in one region; the flanks are those whose region is a helical sweep.
+    std::size_t flanks = 0;
+    for (const auto& [t, areas] : by_region) {
+        if (facets[t] < 500 || t < 0 || static_cast<std::size_t>(t) >= part.faces.size() ||
+            part.faces[static_cast<std::size_t>(t)].kind != "bspline")
+            continue;
+        double total = 0, largest = 0;
+        std::int32_t main = -1;
+        for (const auto& [g, a] : areas) {
+            total += a;
+            if (a > largest) largest = a, main = g;
+        }
+        EXPECT_GE(largest, 0.99 * total) << "true face " << t << ": " << largest / total;
+        const Surface& s = seg.value().regions[static_cast<std::size_t>(main)].fit.surface;
+        if (s.kind == FitKind::kBSpline && s.bspline && s.bspline->helical) ++flanks;
+    }
+    EXPECT_EQ(flanks, 2u);
+}
+
 // Parts full of coarse fillets (10-degree strips of long facets, corners of small tori and
 // balls), face for face. FTC 10 had 191 of 214 true faces each one region (fillets one plane
 // per strip; rings of fillets about rounded corners in ten pieces), FTC 07 200 of 269 (its

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <queue>
@@ -2358,13 +2359,118 @@ std::vector<std::uint32_t> grow_loose(Context& c, std::vector<Draft>& drafts) {
     return grown;
 }
 
+/// Facet f moved along a helical sweep's screw motion (fit_helical()) to the middle of the
+/// angles its surface spans, from the turn whose profile heights its middle lies at (`turn`
+/// 0) or the next one towards it (1): the sweep is invariant under the motion, so the moved
+/// facet's distances to the surface are the facet's to the sweep unbounded along its helix.
+struct MovedFacet {
+    std::array<Vec3, 3> corners;
+    Vec3 middle, normal;
+};
+MovedFacet along_helix(const Context& c, const BSplineSurface::Helix& hx, std::uint32_t f,
+                       int turn) {
+    constexpr double kTwoPi = 2 * std::numbers::pi;
+    const Vec3 q = c.fd.centroid[f] - hx.origin;
+    const double z = dot(q, hx.axis);
+    const double theta = std::atan2(dot(q, cross(hx.axis, hx.x)), dot(q, hx.x));
+    const double turns = ((z - hx.h) / hx.pitch - theta) / kTwoPi;
+    const double k =
+        turn == 0 ? std::round(turns) : std::round(turns) + (turns > std::round(turns) ? 1 : -1);
+    const double d = 0.5 * (hx.a0 + hx.a1) - (theta + kTwoPi * k);
+    const double cd = std::cos(d), sd = std::sin(d);
+    const auto rotate = [&](Vec3 v) {
+        return v * cd + cross(hx.axis, v) * sd + hx.axis * (dot(hx.axis, v) * (1 - cd));
+    };
+    const auto move = [&](Vec3 p) {
+        return hx.origin + rotate(p - hx.origin) + hx.axis * (hx.pitch * d);
+    };
+    MovedFacet out;
+    for (int i = 0; i < 3; ++i)
+        out.corners[static_cast<std::size_t>(i)] = move(c.m.position(c.m.vertex(fid(f), i)));
+    out.middle = move(c.fd.centroid[f]);
+    out.normal = rotate(c.fd.normal[f]);
+    return out;
+}
+
+/// Whether facet f lies on the helical sweep s unbounded along its helix, as facet_fits() asks
+/// of a facet and a surface: corners within the tolerance, middle within kMiddleSagFactor
+/// deflections, normal agreeing within kSegmentNormalAngle.
+bool fits_along_helix(const Context& c, const Surface& s, std::uint32_t f) {
+    const BSplineSurface::Helix& hx = s.bspline->helix;
+    for (const int turn : {0, 1}) {
+        const MovedFacet mf = along_helix(c, hx, f, turn);
+        bool on = true;
+        for (const Vec3& p : mf.corners) on = on && distance(s, p) <= c.tol;
+        if (on && distance(s, mf.middle) <= kMiddleSagFactor * c.sag &&
+            std::abs(dot(normal_at(s, mf.middle), mf.normal)) >= c.cos_normal)
+            return true;
+    }
+    return false;
+}
+
+/// Whether a region's own surface says little of its facets: a B-spline that is no helical
+/// sweep, a loose analytic region (Draft::loose), a small one (kSmallRegion), or one whose
+/// vertices' RMS residual passes kLooseRms x the deflection (no analytic face of the file, as
+/// merge_loose_pieces() says). Not one given by SRE. Cached per region in `known` (-1: unknown).
+bool vague_region(Context& c, const Draft& d, std::int8_t& known) {
+    if (known < 0) {
+        const Surface& s = d.surface;
+        bool v = false;
+        if (d.alive && d.surface_index < 0) {
+            v = (s.kind == FitKind::kBSpline && s.bspline && !s.bspline->helical) || d.loose > 0 ||
+                d.faces.size() <= kSmallRegion;
+            if (!v) {
+                PointSet own;
+                c.gatherers.local().gather(c.m, c.fd, d.faces, own);
+                v = residuals(s, FitInput{own.points, own.normals, {}}).rms > kLooseRms * c.sag;
+            }
+        }
+        known = v ? 1 : 0;
+    }
+    return known > 0;
+}
+
+/// The facets of region s's neighbours, reached across smooth edges ring by ring, that lie on
+/// its helical sweep unbounded along its helix (fits_along_helix()): the flank's facets in a
+/// piece that holds the flank's end and part of the thread's faded end, which fits no sweep
+/// whole. Only from a piece whose own surface says little: a B-spline that is no helical sweep,
+/// a loose analytic region, a small one. Sorted.
+std::vector<std::uint32_t> facets_along_helix(Context& c, const std::vector<Draft>& drafts,
+                                              const std::vector<std::uint32_t>& region,
+                                              std::uint32_t s, std::vector<std::int8_t>& vague) {
+    const Surface& sweep = drafts[s].surface;
+    std::vector<std::uint32_t> taken, ring = drafts[s].faces, next;
+    std::vector<std::uint8_t> seen(c.m.num_faces(), 0);
+    while (!ring.empty()) {
+        next.clear();
+        for (const std::uint32_t f : ring) {
+            for (std::uint32_t i = 0; i < 3; ++i) {
+                const std::uint32_t g = c.fd.adj[f][i];
+                if (g == kNone || seen[g] || c.sharp_edge[3 * f + i]) continue;
+                const std::uint32_t r = region[g];
+                if (r == s || r == kNone) continue;
+                if (!vague_region(c, drafts[r], vague[r])) continue;
+                seen[g] = 1;
+                if (!fits_along_helix(c, sweep, g)) continue;
+                taken.push_back(g);
+                next.push_back(g);
+            }
+        }
+        std::swap(ring, next);
+    }
+    std::sort(taken.begin(), taken.end());
+    return taken;
+}
+
 /// Thread flanks: a free-form region whose facets fit one helical sweep (fit_helical(); half a
 /// turn of a flank fixes its screw motion) takes its smoothly joined neighbours, of any kind,
 /// whose facets lie on that sweep (chords_agree()) while the sweep refitted to them all stays
 /// within the chordal deflection: the flank's other pieces along its helix, a B-spline patch, cone
 /// and torus pieces and one-facet planes each, become one region. Kept when the sweep pays as an
 /// extrusion does (extrusion_pays(): within kFreeformRms x the pieces' RMS, in fewer numbers).
-/// Seeds are taken largest first. Returns the regions that grew.
+/// A region kept then takes the facets of vague neighbours that lie on its sweep
+/// (facets_along_helix()), when the sweep refitted to them still holds. Seeds are taken largest
+/// first. Returns the regions that grew or gave facets.
 std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts) {
     std::vector<std::uint32_t> grown;
     const auto open = [&](std::uint32_t r) {
@@ -2381,7 +2487,7 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
     std::stable_sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
         return drafts[a].faces.size() > drafts[b].faces.size();
     });
-    const std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
     std::vector<std::vector<std::uint32_t>> nbrs(drafts.size());
     // Along smooth edges only: a crease (the flank's edge with the thread's crest or root, a
     // coaxial cylinder that every screw motion about the axis keeps in place) is a face's edge.
@@ -2394,6 +2500,7 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
         return fit_helical(FitInput{ps.points, ps.normals, {}}, c.sag);  // ok: within the sag
     };
     std::vector<std::uint8_t> tried(drafts.size(), 0);
+    std::vector<std::int8_t> known(drafts.size(), -1);
     for (const std::uint32_t s : seeds) {
         if (!open(s) || tried[s]) continue;
         FitResult best = helix_of(drafts[s].faces);
@@ -2431,10 +2538,37 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
         drafts[s].faces = std::move(faces);
         drafts[s].surface = best.surface;
         for (std::size_t i = 1; i < group.size(); ++i) {
+            for (const std::uint32_t f : drafts[group[i]].faces) region[f] = s;
             drafts[group[i]].alive = false;
             drafts[group[i]].faces.clear();
         }
         grown.push_back(s);
+        known[s] = -1;  // a helical sweep now
+        // Then the flank's facets in pieces it could not take whole, when the sweep refitted
+        // to them as well still holds.
+        const std::vector<std::uint32_t> taken = facets_along_helix(c, drafts, region, s, known);
+        if (taken.empty()) continue;
+        std::vector<std::uint32_t> more = drafts[s].faces;
+        more.insert(more.end(), taken.begin(), taken.end());
+        std::sort(more.begin(), more.end());
+        FitResult r = helix_of(more);
+        if (!r.ok || !chords_agree(c, r.surface, more)) continue;
+        std::vector<std::uint32_t> donors;
+        for (const std::uint32_t f : taken) {
+            donors.push_back(region[f]);
+            region[f] = s;
+        }
+        std::sort(donors.begin(), donors.end());
+        donors.erase(std::unique(donors.begin(), donors.end()), donors.end());
+        for (const std::uint32_t d : donors) {
+            std::erase_if(drafts[d].faces, [&](std::uint32_t f) { return region[f] == s; });
+            if (drafts[d].faces.empty())
+                drafts[d].alive = false;
+            else
+                grown.push_back(d);
+        }
+        drafts[s].faces = std::move(more);
+        drafts[s].surface = r.surface;
     }
     return grown;
 }
