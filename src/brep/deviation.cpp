@@ -203,10 +203,26 @@ DistanceStats stats_of(const std::vector<Vec3>& points, const TriangleTree& tree
 
 }  // namespace
 
+/// BRepMesh's angular deflection for the solid's triangulation, and its own default, which a
+/// face it leaves without triangles at the first gets (triangulate()).
+constexpr double kMeshAngle = 0.2;
+constexpr double kMeshAngleDefault = 0.5;
+
+void triangulate(const TopoDS_Shape& shape, double deflection, bool parallel) {
+    BRepMesh_IncrementalMesh(shape, deflection, false, kMeshAngle, parallel);
+    for (TopExp_Explorer x(shape, TopAbs_FACE); x.More(); x.Next()) {
+        const TopoDS_Face& face = TopoDS::Face(x.Current());
+        TopLoc_Location loc;
+        if (BRep_Tool::Triangulation(face, loc).IsNull()) {
+            BRepMesh_IncrementalMesh(face, deflection, false, kMeshAngleDefault, false);
+        }
+    }
+}
+
 std::vector<std::array<double, 3>> untriangulated_faces(const TopoDS_Shape& shape,
                                                         double deflection) {
     std::vector<std::array<double, 3>> out;
-    BRepMesh_IncrementalMesh(shape, deflection, false, 0.2, true);
+    triangulate(shape, deflection, true);
     for (TopExp_Explorer x(shape, TopAbs_FACE); x.More(); x.Next()) {
         const TopoDS_Face& face = TopoDS::Face(x.Current());
         TopLoc_Location loc;
@@ -229,9 +245,7 @@ std::vector<double> faces_from_mesh(std::span<const TopoDS_Face> faces, const Me
     // Faces share their edges' polygons: those without triangles are meshed one at a time.
     for (const TopoDS_Face& face : faces) {
         TopLoc_Location loc;
-        if (BRep_Tool::Triangulation(face, loc).IsNull()) {
-            BRepMesh_IncrementalMesh(face, deflection, false, 0.2, false);
-        }
+        if (BRep_Tool::Triangulation(face, loc).IsNull()) triangulate(face, deflection, false);
     }
     std::vector<double> out(faces.size(), -1.0);
     tbb::parallel_for(std::size_t{0}, faces.size(), [&](std::size_t k) {
@@ -253,7 +267,7 @@ SolidDeviation measure_deviation(const TopoDS_Shape& shape, const Mesh& mesh, do
     SolidDeviation out;
     out.deflection = deflection;
     // In parallel over faces (each face's triangulation does not depend on the others').
-    BRepMesh_IncrementalMesh(shape, deflection, false, 0.2, true);
+    triangulate(shape, deflection, true);
     std::vector<Triangle> solid_tris;
     std::vector<Vec3> solid_nodes;
     for (TopExp_Explorer x(shape, TopAbs_FACE); x.More(); x.Next()) {

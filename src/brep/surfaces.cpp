@@ -26,7 +26,6 @@
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepLib.hxx>
-#include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
@@ -86,6 +85,7 @@
 #include <unordered_set>
 
 #include "brep/check.h"
+#include "brep/deviation.h"
 #include "ncrev/segment.h"
 
 namespace ncrev::brep_detail {
@@ -2735,7 +2735,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     return;
                 }
                 if (opt.mesh_deflection > 0) {
-                    BRepMesh_IncrementalMesh(fc.copy, opt.mesh_deflection, false, 0.2, false);
+                    triangulate(fc.copy, opt.mesh_deflection, false);
                     TopLoc_Location loc;
                     if (BRep_Tool::Triangulation(fc.copy, loc).IsNull()) {
                         fc.failure = kUntriangulated;
