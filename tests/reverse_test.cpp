@@ -671,7 +671,10 @@ TEST(ReverseSurfaces, CornersOfFourSurfacesAreOneVertex) {
 // each one face of 1000-1100 facets over seven turns, were 19 regions each (B-spline patches,
 // cone and torus pieces, one-facet planes): 62 faces. A patch of half a turn fixes the flank's
 // screw motion (fit_helical()) and merge_helical() takes the rest of the flank onto it: each
-// flank is one helical sweep, 28 faces for the original's 28.
+// flank is one helical sweep, 28 faces for the original's 28 — which the original writes for
+// 18 surfaces, and 9 of those 28 were slivers on the thread's faded end. What the flanks leave
+// of the patches that held their ends grows over the faded end's small pieces into one sweep
+// (merge_helical()): 20 faces.
 TEST(ReverseSurfaces, AThreadedScrewIsNotBuiltWhollyPlanar) {
     const auto path = corpus_step_dir() / "build123d_M6-1x12-countersunk-screw.step";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus at " << path;
@@ -679,8 +682,9 @@ TEST(ReverseSurfaces, AThreadedScrewIsNotBuiltWhollyPlanar) {
     expect_solid(o, "m6_screw");
     for (const ReverseFallback& f : o.report.fallbacks) ADD_FAILURE() << f.reason;
     EXPECT_EQ(o.report.faces_by_kind.count("facet"), 0u);
-    EXPECT_LE(static_cast<double>(o.report.faces), 1.05 * static_cast<double>(o.true_faces))
-        << o.report.faces << " faces for " << o.true_faces;
+    ASSERT_GT(o.one_surface_faces, 0u);
+    EXPECT_LE(static_cast<double>(o.report.faces), 1.15 * static_cast<double>(o.one_surface_faces))
+        << o.report.faces << " faces for " << o.one_surface_faces << " surfaces";
     // The flanks and the thread's faded ends (the original's 6 B-splines).
     const auto bsplines = o.report.faces_by_kind.find("bspline");
     EXPECT_LE(bsplines == o.report.faces_by_kind.end() ? 0u : bsplines->second, 6u);

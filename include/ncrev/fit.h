@@ -161,6 +161,9 @@ FitResult residuals(const Surface& surface, const FitInput& input);
 /// to within 1e-4 of the points' extent (see fit_bspline()). Never throws.
 FitResult fit(FitKind kind, const FitInput& input);
 
+/// The fewest points fit_bspline() and fit_helical() take: a bicubic net's 16 poles.
+inline constexpr std::size_t kMinBSplinePoints = 16;
+
 /// A helical sweep: a planar profile swept along a helix about an axis found from the normals
 /// and refined on the points — a thread's flank. fit_bspline() does not try it (on a quarter
 /// turn a wrong motion still fits); segmentation asks for it where a region is a B-spline. ok false

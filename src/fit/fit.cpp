@@ -2632,7 +2632,7 @@ std::optional<FitResult> unfit_for_bspline(const FitInput& in) {
     if (!in.weights.empty() && in.weights.size() != in.points.size()) {
         return failed(FitKind::kBSpline, "weights and points differ in number");
     }
-    if (in.points.size() < 16) return failed(FitKind::kBSpline, "too few points");
+    if (in.points.size() < kMinBSplinePoints) return failed(FitKind::kBSpline, "too few points");
     for (std::size_t i = 0; i < in.points.size(); ++i) {
         if (!finite(in.points[i]) || (!in.weights.empty() && !(in.weights[i] >= 0))) {
             return failed(FitKind::kBSpline, "a point or weight is not a finite number");

@@ -2430,6 +2430,16 @@ bool vague_region(Context& c, const Draft& d, std::int8_t& known) {
     return known > 0;
 }
 
+/// The number of distinct vertices of `faces`.
+std::size_t point_count(const Context& c, std::span<const std::uint32_t> faces) {
+    std::vector<std::uint32_t> v;
+    v.reserve(3 * faces.size());
+    for (const std::uint32_t f : faces)
+        for (int i = 0; i < 3; ++i) v.push_back(c.m.vertex(fid(f), i).idx());
+    std::sort(v.begin(), v.end());
+    return static_cast<std::size_t>(std::unique(v.begin(), v.end()) - v.begin());
+}
+
 /// The facets of region s's neighbours, reached across smooth edges ring by ring, that lie on
 /// its helical sweep unbounded along its helix (fits_along_helix()): the flank's facets in a
 /// piece that holds the flank's end and part of the thread's faded end, which fits no sweep
@@ -2499,12 +2509,11 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
         c.gatherers.local().gather(c.m, c.fd, faces, ps);
         return fit_helical(FitInput{ps.points, ps.normals, {}}, c.sag);  // ok: within the sag
     };
-    std::vector<std::uint8_t> tried(drafts.size(), 0);
+    std::vector<std::uint8_t> tried(drafts.size(), 0), gave(drafts.size(), 0);
     std::vector<std::int8_t> known(drafts.size(), -1);
+    const auto vague = [&](std::uint32_t r) { return vague_region(c, drafts[r], known[r]); };
     for (const std::uint32_t s : seeds) {
         if (!open(s) || tried[s]) continue;
-        FitResult best = helix_of(drafts[s].faces);
-        if (!best.ok) continue;
         std::vector<std::uint32_t> group{s}, faces = drafts[s].faces, frontier;
         mark[s] = s;
         const auto reach = [&](std::uint32_t r) {
@@ -2515,6 +2524,23 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
             }
         };
         reach(s);
+        FitResult best = helix_of(faces);
+        // What is left of a piece that gave a flank its end (facets_along_helix()) lies on the
+        // thread's faded end, which is in small pieces: too few points for a fit, it first
+        // takes its vague smooth neighbours, lowest index first, until it has enough.
+        while (!best.ok && gave[s] && point_count(c, faces) < kMinBSplinePoints) {
+            auto low = frontier.end();
+            for (auto it = frontier.begin(); it != frontier.end(); ++it)
+                if (vague(*it) && (low == frontier.end() || *it < *low)) low = it;
+            if (low == frontier.end()) break;
+            const std::uint32_t n = *low;
+            frontier.erase(low);
+            group.push_back(n);
+            faces.insert(faces.end(), drafts[n].faces.begin(), drafts[n].faces.end());
+            reach(n);
+            best = helix_of(faces);
+        }
+        if (!best.ok) continue;
         while (!frontier.empty()) {
             // The smallest index first: the same order whatever the threads.
             const auto it = std::min_element(frontier.begin(), frontier.end());
@@ -2556,6 +2582,7 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
         std::vector<std::uint32_t> donors;
         for (const std::uint32_t f : taken) {
             donors.push_back(region[f]);
+            gave[region[f]] = 1;
             region[f] = s;
         }
         std::sort(donors.begin(), donors.end());
