@@ -934,9 +934,11 @@ TEST(ReverseSurfaces, AThreadFlankIsOneRegionToItsEnd) {
     ASSERT_TRUE(seg.ok());
     std::map<std::int64_t, std::map<std::int32_t, double>> by_region;  // true face -> areas
     std::map<std::int64_t, std::size_t> facets;
+    std::map<std::int32_t, double> region_area;
     for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
         const FaceId ff(static_cast<std::uint32_t>(f));
         by_region[mesh.cuts()[f]][seg.value().region[ff]] += mesh.face_area(ff);
+        region_area[seg.value().region[ff]] += mesh.face_area(ff);
         ++facets[mesh.cuts()[f]];
     }
     // Each large free-form face of the original (the flanks, and the crest, a cylinder written
@@ -953,8 +955,13 @@ TEST(ReverseSurfaces, AThreadFlankIsOneRegionToItsEnd) {
             if (a > largest) largest = a, main = g;
         }
         EXPECT_GE(largest, 0.99 * total) << "true face " << t << ": " << largest / total;
+        ASSERT_GE(main, 0);
         const Surface& s = seg.value().regions[static_cast<std::size_t>(main)].fit.surface;
-        if (s.kind == FitKind::kBSpline && s.bspline && s.bspline->helical) ++flanks;
+        if (!(s.kind == FitKind::kBSpline && s.bspline && s.bspline->helical)) continue;
+        ++flanks;
+        // And the flank's region takes little else (the faded end's facets on its sweep).
+        EXPECT_GE(largest, 0.99 * region_area[main])
+            << "flank region " << main << ": " << largest / region_area[main];
     }
     EXPECT_EQ(flanks, 2u);
 }

@@ -2392,10 +2392,12 @@ MovedFacet along_helix(const Context& c, const BSplineSurface::Helix& hx, std::u
     return out;
 }
 
-/// Whether facet f lies on the helical sweep s unbounded along its helix, as facet_fits() asks
-/// of a facet and a surface: corners within the tolerance, middle within kMiddleSagFactor
-/// deflections, normal agreeing within kSegmentNormalAngle.
+/// Whether facet f lies on the helical sweep s unbounded along its helix: corners within the
+/// tolerance, middle within kMiddleSagFactor deflections, normal within kSegmentNormalAngle of
+/// the surface's at the middle (facet_fits() without normal_agrees()'s allowance for large fan
+/// triangles, which a flank's rows are not).
 bool fits_along_helix(const Context& c, const Surface& s, std::uint32_t f) {
+    if (!s.bspline || !s.bspline->helical || !(s.bspline->helix.pitch != 0)) return false;
     const BSplineSurface::Helix& hx = s.bspline->helix;
     for (const int turn : {0, 1}) {
         const MovedFacet mf = along_helix(c, hx, f, turn);
@@ -2411,12 +2413,14 @@ bool fits_along_helix(const Context& c, const Surface& s, std::uint32_t f) {
 /// Whether a region's own surface says little of its facets: a B-spline that is no helical
 /// sweep, a loose analytic region (Draft::loose), a small one (kSmallRegion), or one whose
 /// vertices' RMS residual passes kLooseRms x the deflection (no analytic face of the file, as
-/// merge_loose_pieces() says). Not one given by SRE. Cached per region in `known` (-1: unknown).
+/// merge_loose_pieces() says). Never a helical sweep, nor a region given by SRE. Cached per
+/// region in `known` (-1: unknown). A region that gave facets keeps its verdict and its
+/// surface (fitted to more than it now holds) until the final fit.
 bool vague_region(Context& c, const Draft& d, std::int8_t& known) {
     if (known < 0) {
         const Surface& s = d.surface;
         bool v = false;
-        if (d.alive && d.surface_index < 0) {
+        if (d.alive && d.surface_index < 0 && !(s.bspline && s.bspline->helical)) {
             v = (s.kind == FitKind::kBSpline && s.bspline && !s.bspline->helical) || d.loose > 0 ||
                 d.faces.size() <= kSmallRegion;
             if (!v) {
@@ -2438,6 +2442,22 @@ std::size_t point_count(const Context& c, std::span<const std::uint32_t> faces) 
         for (int i = 0; i < 3; ++i) v.push_back(c.m.vertex(fid(f), i).idx());
     std::sort(v.begin(), v.end());
     return static_cast<std::size_t>(std::unique(v.begin(), v.end()) - v.begin());
+}
+
+/// Whether a facet of `faces` shares a smooth edge with one of `group`.
+bool touches_smoothly(const Context& c, std::span<const std::uint32_t> faces,
+                      std::span<const std::uint32_t> group) {
+    std::vector<std::uint32_t> sorted(group.begin(), group.end());
+    std::sort(sorted.begin(), sorted.end());
+    for (const std::uint32_t f : faces) {
+        for (std::uint32_t i = 0; i < 3; ++i) {
+            const std::uint32_t g = c.fd.adj[f][i];
+            if (g != kNone && !c.sharp_edge[3 * f + i] &&
+                std::binary_search(sorted.begin(), sorted.end(), g))
+                return true;
+        }
+    }
+    return false;
 }
 
 /// The facets of region s's neighbours, reached across smooth edges ring by ring, that lie on
@@ -2528,10 +2548,15 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
         // What is left of a piece that gave a flank its end (facets_along_helix()) lies on the
         // thread's faded end, which is in small pieces: too few points for a fit, it first
         // takes its vague smooth neighbours, lowest index first, until it has enough.
+        // Adjacency is checked on the facets: the region lists were made before any capture,
+        // and a donor no longer touches what it touched only through the facets it gave.
         while (!best.ok && gave[s] && point_count(c, faces) < kMinBSplinePoints) {
             auto low = frontier.end();
-            for (auto it = frontier.begin(); it != frontier.end(); ++it)
-                if (vague(*it) && (low == frontier.end() || *it < *low)) low = it;
+            for (auto it = frontier.begin(); it != frontier.end(); ++it) {
+                if ((low == frontier.end() || *it < *low) && vague(*it) &&
+                    touches_smoothly(c, drafts[*it].faces, faces))
+                    low = it;
+            }
             if (low == frontier.end()) break;
             const std::uint32_t n = *low;
             frontier.erase(low);
@@ -2540,6 +2565,8 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
             reach(n);
             best = helix_of(faces);
         }
+        // Taken unchecked: its sweep must have the facets as chords, as every growth step asks.
+        if (best.ok && group.size() > 1 && !chords_agree(c, best.surface, faces)) best.ok = false;
         if (!best.ok) continue;
         while (!frontier.empty()) {
             // The smallest index first: the same order whatever the threads.
