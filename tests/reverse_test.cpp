@@ -32,6 +32,7 @@
 #include <fstream>
 #include <gp_Pnt.hxx>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
 #include <span>
@@ -41,6 +42,7 @@
 #include "ncrev/brep.h"
 #include "ncrev/fit.h"
 #include "ncrev/io.h"
+#include "ncrev/report.h"
 #include "ncrev/sample.h"
 #include "ncrev/segment.h"
 #include "sample_cases.h"
@@ -959,6 +961,10 @@ TEST(ReverseSurfaces, AThreadFlankIsOneRegionToItsEnd) {
         const Surface& s = seg.value().regions[static_cast<std::size_t>(main)].fit.surface;
         if (!(s.kind == FitKind::kBSpline && s.bspline && s.bspline->helical)) continue;
         ++flanks;
+        // Its screw motion is the thread's, as the JSON reports it: M6 x 1, about the z axis.
+        const auto helix = nlohmann::json::parse(surface_params_json(s))["helix"];
+        EXPECT_NEAR(std::abs(helix["pitch"].get<double>()), 1.0, 1e-3);
+        EXPECT_NEAR(std::abs(helix["axis_dir"][2].get<double>()), 1.0, 1e-6);
         // And the flank's region takes little else (the faded end's facets on its sweep).
         EXPECT_GE(largest, 0.99 * region_area[main])
             << "flank region " << main << ": " << largest / region_area[main];

@@ -85,6 +85,10 @@ struct BSplineSurface {
     struct Helix {
         Vec3 origin, axis{0, 0, 1}, x{1, 0, 0};
         double pitch = 0, a0 = 0, a1 = 0, h = 0;
+        /// `p`'s angle about the axis from `x` (in [-pi, pi]), and how many turns its height
+        /// less pitch x that angle lies from the profile's heights about `h`, unrounded: the
+        /// turn whose profile p lies at is the angle plus 2 pi x the nearest whole number.
+        double turns(Vec3 p, double& angle) const;
     } helix;
     /// The surface at the grid of parameters where projections onto it start (distance(),
     /// closest_point(), normal_at()), filled by fit_bspline(); evaluated on each call when

@@ -74,7 +74,8 @@ std::string to_text(const CurvatureResult& curvature, Unit unit);
 /// major_radius (negative for the inner, lemon part of a spindle torus: ncrev/fit.h),
 /// minor_radius; shear_cylinder center, axis_dir, radius, sweep_dir;
 /// swept_torus center, axis_dir, major_radius, minor_radius, sweep_dir; bspline degree,
-/// num_u, num_v, poles (num_u x num_v points, u fastest).
+/// num_u, num_v, poles (num_u x num_v points, u fastest), and for a helical sweep helix
+/// (axis_point, axis_dir, pitch: the climb per turn along axis_dir, negative for a left hand).
 std::string to_json(const InfoReport& info, const SegmentResult& segment, int indent = 2);
 
 /// The region parameters of to_json() for one surface.

@@ -145,6 +145,12 @@ void BSplineSurface::evaluate(double u, double v, Vec3& p, Vec3& du, Vec3& dv) c
     }
 }
 
+double BSplineSurface::Helix::turns(Vec3 p, double& angle) const {
+    const Vec3 d = p - origin;
+    angle = std::atan2(dot(d, cross(axis, x)), dot(d, x));
+    return (dot(d, axis) - pitch * angle - h) / (2 * std::numbers::pi * pitch);
+}
+
 Vec3 BSplineSurface::evaluate(double u, double v) const {
     Vec3 p, du, dv;
     evaluate(u, v, p, du, dv);
@@ -1294,10 +1300,8 @@ void coarse_start(const BSplineSurface& b, Vec3 p, double& u, double& v) {
     int j0 = 0, j1 = gv, k0 = 1, k1 = 0;
     const BSplineSurface::Helix& hx = b.helix;
     if (b.helical && hx.a1 > hx.a0 && hx.pitch != 0 && gv > 0) {
-        const Vec3 d = p - hx.origin;
-        const double z = dot(d, hx.axis);
-        const double th = std::atan2(dot(d, cross(hx.axis, hx.x)), dot(d, hx.x));
-        const double turns = (z - hx.pitch * th - hx.h) / (2 * kPi * hx.pitch);
+        double th = 0;
+        const double turns = hx.turns(p, th);
         const auto row = [&](double turn) {
             const double at = std::clamp((th + 2 * kPi * turn - hx.a0) / (hx.a1 - hx.a0), 0.0, 1.0);
             return std::isfinite(at) ? static_cast<int>(std::lround(at * gv)) : -1;
@@ -1721,6 +1725,32 @@ bool profile_parameters(const std::vector<double>& x, const std::vector<double>&
     return true;
 }
 
+/// The point of a planar cubic profile (np poles (px[a], py[a]), `knots` from cubic_knots(np))
+/// nearest (x, y), by Newton's method from the parameter u, kept in [0, 1]: u becomes its
+/// parameter, (cx, cy) the point and (dx, dy) the profile's derivative there.
+void nearest_on_profile(int np, const double* knots, const double* px, const double* py, double x,
+                        double y, double& u, double& cx, double& cy, double& dx, double& dy) {
+    const auto at = [&](double t) {
+        double N[kMaxDegree + 1], dN[kMaxDegree + 1];
+        const int sp = cubic_basis(np, t, N, dN, knots) - 3;
+        cx = cy = dx = dy = 0;
+        for (int a = 0; a <= 3; ++a) {
+            cx += N[a] * px[sp + a], cy += N[a] * py[sp + a];
+            dx += dN[a] * px[sp + a], dy += dN[a] * py[sp + a];
+        }
+    };
+    for (int it = 0; it < kProjectIterations; ++it) {
+        at(u);
+        const double dd = dx * dx + dy * dy;
+        if (!(dd > 0)) break;
+        const double nu = std::clamp(u - ((cx - x) * dx + (cy - y) * dy) / dd, 0.0, 1.0);
+        const bool done = std::fabs(nu - u) < 1e-13;
+        u = nu;
+        if (done) break;
+    }
+    at(u);
+}
+
 /// A planar profile swept along a rigid motion (fit_extrusion(), helical_sweep()): each point's
 /// coordinates (x, y) in the profile's plane and its normal's components there (ux, uy), and
 /// the B-spline surface of the profile whose poles are (px, py) in that plane, with `slack`
@@ -1848,33 +1878,13 @@ FitResult fit_profile_sweep(const FitInput& in, double tolerance, bool& capped,
         // the extrusion: every point lies within the extrusion's span), from its projection.
         std::vector<double> off(n, 0.0);
         const std::vector<double> knots = cubic_knots(np);
-        // The profile's point at u and its derivative there.
-        const auto curve = [&](double u, double& cx, double& cy, double& dx, double& dy) {
-            double N[kMaxDegree + 1], dN[kMaxDegree + 1];
-            const int sp = cubic_basis(np, u, N, dN, knots.data()) - 3;
-            cx = cy = dx = dy = 0;
-            for (int a = 0; a <= 3; ++a) {
-                cx += N[a] * px(sp + a), cy += N[a] * py(sp + a);
-                dx += dN[a] * px(sp + a), dy += dN[a] * py(sp + a);
-            }
-        };
         const auto project = [&]() {
             double far = 0;
             for (std::size_t i = 0; i < all; ++i) {
-                double u = s[i], cx = 0, cy = 0, dx = 0, dy = 0;
-                for (int it = 0; it < kProjectIterations; ++it) {
-                    curve(u, cx, cy, dx, dy);
-                    const double dd = dx * dx + dy * dy;
-                    if (!(dd > 0)) break;
-                    const double nu =
-                        std::clamp(u - ((cx - xs[i]) * dx + (cy - ys[i]) * dy) / dd, 0.0, 1.0);
-                    const bool done = std::fabs(nu - u) < 1e-13;
-                    u = nu;
-                    if (done) break;
-                }
-                s[i] = u;
+                double cx = 0, cy = 0, dx = 0, dy = 0;
+                nearest_on_profile(np, knots.data(), px.data(), py.data(), xs[i], ys[i], s[i], cx,
+                                   cy, dx, dy);
                 if (i < n) {
-                    curve(u, cx, cy, dx, dy);
                     off[i] = std::hypot(cx - xs[i], cy - ys[i]);
                     far = std::max(far, off[i]);
                 }
@@ -2063,22 +2073,9 @@ void refine_screw(const FitInput& in, double tolerance, const std::vector<double
         for (std::size_t i = 0; i < n; ++i) {
             double px = 0, py = 0;
             place(mm, i, px, py);
-            double u = par[i], cx = 0, cy = 0, dx = 0, dy = 0;
-            for (int it = 0; it <= kProjectIterations; ++it) {
-                double N[kMaxDegree + 1], dN[kMaxDegree + 1];
-                const int sp = cubic_basis(np, u, N, dN, knots.data()) - 3;
-                cx = cy = dx = dy = 0;
-                for (int a = 0; a <= 3; ++a) {
-                    cx += N[a] * pl(sp + a), cy += N[a] * pl(np + sp + a);
-                    dx += dN[a] * pl(sp + a), dy += dN[a] * pl(np + sp + a);
-                }
-                const double dd = dx * dx + dy * dy;
-                if (it == kProjectIterations || !(dd > 0)) break;
-                const double nu = std::clamp(u - ((cx - px) * dx + (cy - py) * dy) / dd, 0.0, 1.0);
-                if (std::fabs(nu - u) < 1e-13) break;
-                u = nu;
-            }
-            par[i] = u;
+            double cx = 0, cy = 0, dx = 0, dy = 0;
+            nearest_on_profile(np, knots.data(), pl.data(), pl.data() + np, px, py, par[i], cx, cy,
+                               dx, dy);
             const double l = std::hypot(dx, dy);
             nx[i] = l > 0 ? -dy / l : 0, ny[i] = l > 0 ? dx / l : 0;
             res[i] = (px - cx) * nx[i] + (py - cy) * ny[i];
@@ -2163,7 +2160,7 @@ void refine_screw(const FitInput& in, double tolerance, const std::vector<double
 FitResult helical_sweep(const FitInput& in, double tolerance) {
     FitResult fail = failed(FitKind::kBSpline, "not a helical sweep");
     const std::size_t n = in.points.size();
-    if (in.normals.size() != n || n < 16 || !(tolerance > 0)) return fail;
+    if (in.normals.size() != n || n < kMinBSplinePoints || !(tolerance > 0)) return fail;
     double total = 0;
     const Vec3 c = centroid(in, &total);
     double spread = 0;

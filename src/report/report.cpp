@@ -293,10 +293,18 @@ nlohmann::json params_json(const Surface& s) {
             if (s.bspline) {
                 for (const Vec3& p : s.bspline->poles) poles.push_back(vec(p));
             }
-            return {{"degree", s.bspline ? s.bspline->degree : 3},
-                    {"num_u", s.bspline ? s.bspline->num_u : 0},
-                    {"num_v", s.bspline ? s.bspline->num_v : 0},
-                    {"poles", poles}};
+            json out = {{"degree", s.bspline ? s.bspline->degree : 3},
+                        {"num_u", s.bspline ? s.bspline->num_u : 0},
+                        {"num_v", s.bspline ? s.bspline->num_v : 0},
+                        {"poles", poles}};
+            // A thread's flank: its screw motion, the climb per turn signed by the hand.
+            if (s.bspline && s.bspline->helical) {
+                const BSplineSurface::Helix& hx = s.bspline->helix;
+                out["helix"] = {{"axis_point", vec(hx.origin)},
+                                {"axis_dir", vec(hx.axis)},
+                                {"pitch", 2 * std::numbers::pi * hx.pitch}};
+            }
+            return out;
         }
     }
     return json::object();

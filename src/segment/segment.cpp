@@ -2370,10 +2370,8 @@ struct MovedFacet {
 MovedFacet along_helix(const Context& c, const BSplineSurface::Helix& hx, std::uint32_t f,
                        int turn) {
     constexpr double kTwoPi = 2 * std::numbers::pi;
-    const Vec3 q = c.fd.centroid[f] - hx.origin;
-    const double z = dot(q, hx.axis);
-    const double theta = std::atan2(dot(q, cross(hx.axis, hx.x)), dot(q, hx.x));
-    const double turns = ((z - hx.h) / hx.pitch - theta) / kTwoPi;
+    double theta = 0;
+    const double turns = hx.turns(c.fd.centroid[f], theta);
     const double k =
         turn == 0 ? std::round(turns) : std::round(turns) + (turns > std::round(turns) ? 1 : -1);
     const double d = 0.5 * (hx.a0 + hx.a1) - (theta + kTwoPi * k);
