@@ -2300,6 +2300,117 @@ std::vector<std::uint32_t> merge_chords(Context& c, std::vector<Draft>& drafts) 
     return grown;
 }
 
+/// The number of distinct vertices of `faces`.
+std::size_t point_count(const Context& c, std::span<const std::uint32_t> faces) {
+    std::vector<std::uint32_t> v;
+    v.reserve(3 * faces.size());
+    for (const std::uint32_t f : faces)
+        for (int i = 0; i < 3; ++i) v.push_back(c.m.vertex(fid(f), i).idx());
+    std::sort(v.begin(), v.end());
+    return static_cast<std::size_t>(std::unique(v.begin(), v.end()) - v.begin());
+}
+
+/// Fans: a coarse cylinder or cone face as a CAD system tessellates it, one row of facets from
+/// rim to rim with its two rims divided unevenly, comes as one-facet planes, with perhaps a
+/// small cylinder or cone among them. Few of its facets have an edge along a generator
+/// (strip_fit() grows on those), neighbours turn by up to 45 degrees (growing stops at sharp
+/// edges), and merging goes pair by pair while a cylinder needs kMinVertices (6) vertices, four
+/// facets of a fan: the AP242 mesh of NIST FTC 08 had 167 one-facet planes, every one on a
+/// cylinder or a B-spline face. So a seed (a cylinder or cone region, largest first, then a
+/// one-facet region) takes its one-facet neighbours, across any edge and lowest index first,
+/// while a cylinder or cone fits the union within the tolerance with its facets as chords
+/// (fit_faces()); until the union has the vertices for a fit, on trust, and a seed whose trusted
+/// facets no fit takes gets none. A prism's sides lie on their circumscribed cylinder, but their
+/// facets are no chords of it, and a planar face of a CAD tessellation is rarely one facet.
+/// Returns the regions that grew.
+std::vector<std::uint32_t> merge_fans(Context& c, std::vector<Draft>& drafts) {
+    std::vector<std::uint32_t> grown;
+    // A member: a one-facet region, or a cylinder or cone of at most kLooseFacets facets (a
+    // fan's piece that merging made before the rest was there to join).
+    const auto lone = [&](std::uint32_t r) {
+        const Draft& d = drafts[r];
+        if (!d.alive || d.surface_index >= 0 || d.loose > 0) return false;
+        const FitKind k = d.surface.kind;
+        return d.faces.size() == 1 ||
+               (d.faces.size() <= kLooseFacets && (k == FitKind::kCylinder || k == FitKind::kCone));
+    };
+    const auto ruled = [&](std::uint32_t r) {
+        const Draft& d = drafts[r];
+        return d.alive && d.surface_index < 0 && d.loose == 0 &&
+               (d.surface.kind == FitKind::kCylinder || d.surface.kind == FitKind::kCone);
+    };
+    std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    // Any lone region at all? (Most meshes have none left: no pass over the seeds then.)
+    std::vector<std::uint32_t> seeds, lones;
+    for (std::uint32_t r = 0; r < drafts.size(); ++r) {
+        if (lone(r))
+            lones.push_back(r);
+        else if (ruled(r))
+            seeds.push_back(r);
+    }
+    if (lones.empty()) return grown;
+    std::stable_sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return drafts[a].faces.size() > drafts[b].faces.size();
+    });
+    seeds.insert(seeds.end(), lones.begin(), lones.end());
+    constexpr FitKindSet kRuled = fit_kind_bit(FitKind::kCylinder) | fit_kind_bit(FitKind::kCone);
+    std::vector<std::uint32_t> mark(drafts.size(), kNone);
+    for (const std::uint32_t s : seeds) {
+        if (!drafts[s].alive || (!lone(s) && !ruled(s))) continue;
+        const std::optional<FitKind> first =
+            ruled(s) ? std::optional<FitKind>(drafts[s].surface.kind) : std::nullopt;
+        std::vector<std::uint32_t> faces = drafts[s].faces, group{s}, frontier;
+        mark[s] = s;
+        const auto reach = [&](std::span<const std::uint32_t> from) {
+            for (const std::uint32_t f : from) {
+                for (const std::uint32_t g : c.fd.adj[f]) {
+                    if (g == kNone) continue;
+                    const std::uint32_t n = region[g];
+                    if (n == kNone || mark[n] == s || !lone(n)) continue;
+                    mark[n] = s;
+                    frontier.push_back(n);
+                }
+            }
+        };
+        reach(faces);
+        std::optional<FitResult> best;
+        bool trusted = false;  // facets taken before a fit could check them
+        while (!frontier.empty()) {
+            const auto it = std::min_element(frontier.begin(), frontier.end());
+            const std::uint32_t n = *it;
+            frontier.erase(it);
+            std::vector<std::uint32_t> more = faces;
+            more.insert(more.end(), drafts[n].faces.begin(), drafts[n].faces.end());
+            if (point_count(c, more) < kMinVertices[static_cast<int>(FitKind::kCylinder)]) {
+                if (!lone(s)) continue;  // a ruled seed's own fit checks every facet
+                trusted = true;
+            } else {
+                std::optional<FitResult> r = fit_faces(c, more, kRuled, first);
+                if (!r) {
+                    if (trusted && !best) break;  // what it took on trust fits nothing
+                    continue;
+                }
+                best = std::move(r);
+            }
+            group.push_back(n);
+            faces = std::move(more);
+            reach(drafts[n].faces);
+        }
+        // (Facets are taken on trust only before the first fit: best fits them all.)
+        if (!best || group.size() < 2) continue;
+        std::sort(faces.begin(), faces.end());
+        for (std::size_t i = 1; i < group.size(); ++i) {
+            for (const std::uint32_t f : drafts[group[i]].faces) region[f] = s;
+            drafts[group[i]].alive = false;
+            drafts[group[i]].faces.clear();
+        }
+        drafts[s].faces = std::move(faces);
+        drafts[s].surface = best->surface;
+        grown.push_back(s);
+    }
+    return grown;
+}
+
 /// Each loose region (an analytic surface held to the sag: analytic_instead()) takes the
 /// neighbours across smooth edges that its kind, refitted to both, holds as closely as it held
 /// its own vertices (or within the tolerance), their facets its chords: the rest of a bore whose
@@ -2430,16 +2541,6 @@ bool vague_region(Context& c, const Draft& d, std::int8_t& known) {
         known = v ? 1 : 0;
     }
     return known > 0;
-}
-
-/// The number of distinct vertices of `faces`.
-std::size_t point_count(const Context& c, std::span<const std::uint32_t> faces) {
-    std::vector<std::uint32_t> v;
-    v.reserve(3 * faces.size());
-    for (const std::uint32_t f : faces)
-        for (int i = 0; i < 3; ++i) v.push_back(c.m.vertex(fid(f), i).idx());
-    std::sort(v.begin(), v.end());
-    return static_cast<std::size_t>(std::unique(v.begin(), v.end()) - v.begin());
 }
 
 /// Whether a facet of `faces` shares a smooth edge with one of `group`.
@@ -2645,6 +2746,7 @@ double finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRec
         std::vector<std::uint32_t> merged = merge_loose_pieces(c, drafts, fitted);
         result.freeform_groups += merged.size();
         for (const std::uint32_t g : merge_chords(c, drafts)) merged.push_back(g);
+        for (const std::uint32_t g : merge_fans(c, drafts)) merged.push_back(g);
         for (const std::uint32_t g : grow_loose(c, drafts)) merged.push_back(g);
         for (const std::uint32_t g : merge_helical(c, drafts)) merged.push_back(g);
         // The groups' new surfaces may take the small regions left between them and their
