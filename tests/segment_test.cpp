@@ -767,3 +767,47 @@ TEST(SegmentBorders, CornersSolveOntoTheirSurfaces) {
 
 }  // namespace
 }  // namespace ncrev
+
+namespace ncrev {
+namespace {
+
+// A cone's face as a CAD system may tessellate it: one row of slivers from rim to rim (8 tall,
+// radii 10 to 14), each rim in steps of 30 degrees, the bottom's half a step off the top's, so
+// that only the two end facets have an edge along a generator. Growing and merging left seven
+// one-facet planes (pairwise merging never reaches the seven vertices a cone needs);
+// merge_fans() grows one cone through them, taking its first facets on trust until a cone can
+// be fitted (a cylinder, tried at six vertices, does not fit).
+TEST(Segment, AConeFanOfOneFacetPlanesIsOneCone) {
+    const double deg = std::numbers::pi / 180;
+    const std::vector<double> top{0, 30, 60, 90}, bottom{0, 15, 45, 75, 90};
+    TriangleSoup soup;
+    const auto at = [&](double a, double z) {
+        const double r = 10 + 0.5 * z;  // a half-angle of atan(1/2) about z
+        return Vec3{r * std::cos(a * deg), r * std::sin(a * deg), z};
+    };
+    for (const double a : top) soup.points.push_back(at(a, 8));
+    for (const double a : bottom) soup.points.push_back(at(a, 0));
+    const auto nt = static_cast<std::uint32_t>(top.size());
+    std::size_t i = 0, j = 0;  // a zipper: the rim whose next vertex comes first advances
+    while (i + 1 < top.size() || j + 1 < bottom.size()) {
+        const auto ti = static_cast<std::uint32_t>(i), bj = nt + static_cast<std::uint32_t>(j);
+        if (j + 1 == bottom.size() || (i + 1 < top.size() && top[i + 1] <= bottom[j + 1])) {
+            soup.triangles.push_back({ti, bj, ti + 1});
+            ++i;
+        } else {
+            soup.triangles.push_back({ti, bj, bj + 1});
+            ++j;
+        }
+    }
+    ASSERT_EQ(soup.triangles.size(), 7u);
+    const Mesh mesh = build_mesh(soup).value().mesh;
+    const SegmentResult r = segment(mesh).value();
+    ASSERT_EQ(r.regions.size(), 1u);
+    const Surface& s = r.regions[0].fit.surface;
+    EXPECT_EQ(s.kind, FitKind::kCone);
+    EXPECT_NEAR(s.angle, std::atan(0.5), 1e-6);
+    EXPECT_NEAR(std::abs(s.axis.z), 1, 1e-9);
+}
+
+}  // namespace
+}  // namespace ncrev

@@ -126,6 +126,9 @@ constexpr double kOrphanShare = 0.01;
 /// does, so the two are within 2 tolerances of each other there, and by little more a facet
 /// beside them; the rest is margin.
 constexpr double kHopelessTolerances = 10;
+/// A cylinder or cone region of at most this many facets may be a piece of a coarse fan (see
+/// merge_fans()): what pairwise merging makes of two of its facets.
+constexpr std::size_t kFanPieceFacets = 2;
 /// Regions of at most this many facets are dissolved into their neighbours when these fit them.
 constexpr std::size_t kSmallRegion = 8;
 /// Rounds of absorbing small regions (each dissolves facets one row deep at most).
@@ -2317,87 +2320,110 @@ std::size_t point_count(const Context& c, std::span<const std::uint32_t> faces) 
 /// edges), and merging goes pair by pair while a cylinder needs kMinVertices (6) vertices, four
 /// facets of a fan: the AP242 mesh of NIST FTC 08 had 167 one-facet planes, every one on a
 /// cylinder or a B-spline face. So a seed (a cylinder or cone region, largest first, then a
-/// one-facet region) takes its one-facet neighbours, across any edge and lowest index first,
-/// while a cylinder or cone fits the union within the tolerance with its facets as chords
-/// (fit_faces()); until the union has the vertices for a fit, on trust, and a seed whose trusted
-/// facets no fit takes gets none. A prism's sides lie on their circumscribed cylinder, but their
-/// facets are no chords of it, and a planar face of a CAD tessellation is rarely one facet.
-/// Returns the regions that grew.
+/// small region) takes its small neighbours (a facet, or a cylinder or cone of at most
+/// kFanPieceFacets), across any edge and lowest index first, while a cylinder or cone fits the
+/// union within the tolerance with its facets as chords (fit_faces()). A small seed takes them
+/// on trust until a cone could be fitted (7 vertices), and keeps nothing no fit has taken. A
+/// two-facet plane is never a member: a prism's sides lie on their circumscribed cylinder, and a
+/// many-sided one's sides sag less than the deflection; a planar face of a CAD tessellation is
+/// rarely one facet. Returns the regions that grew.
 std::vector<std::uint32_t> merge_fans(Context& c, std::vector<Draft>& drafts) {
     std::vector<std::uint32_t> grown;
-    // A member: a one-facet region, or a cylinder or cone of at most kLooseFacets facets (a
-    // fan's piece that merging made before the rest was there to join).
-    const auto lone = [&](std::uint32_t r) {
-        const Draft& d = drafts[r];
-        if (!d.alive || d.surface_index >= 0 || d.loose > 0) return false;
-        const FitKind k = d.surface.kind;
-        return d.faces.size() == 1 ||
-               (d.faces.size() <= kLooseFacets && (k == FitKind::kCylinder || k == FitKind::kCone));
-    };
     const auto ruled = [&](std::uint32_t r) {
         const Draft& d = drafts[r];
         return d.alive && d.surface_index < 0 && d.loose == 0 &&
                (d.surface.kind == FitKind::kCylinder || d.surface.kind == FitKind::kCone);
     };
-    std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
-    // Any lone region at all? (Most meshes have none left: no pass over the seeds then.)
-    std::vector<std::uint32_t> seeds, lones;
+    // A member: a one-facet region, or a small cylinder or cone (a fan's piece that merging
+    // made before the rest of the fan was there to join).
+    const auto small = [&](std::uint32_t r) {
+        const Draft& d = drafts[r];
+        return d.alive && d.surface_index < 0 && d.loose == 0 &&
+               (d.faces.size() == 1 || (d.faces.size() <= kFanPieceFacets && ruled(r)));
+    };
+    std::vector<std::uint32_t> seeds, smalls;
     for (std::uint32_t r = 0; r < drafts.size(); ++r) {
-        if (lone(r))
-            lones.push_back(r);
+        if (small(r))
+            smalls.push_back(r);
         else if (ruled(r))
             seeds.push_back(r);
     }
-    if (lones.empty()) return grown;
+    // (Most meshes have no small region left: no region map, no pass over the seeds.)
+    if (smalls.empty()) return grown;
     std::stable_sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
         return drafts[a].faces.size() > drafts[b].faces.size();
     });
-    seeds.insert(seeds.end(), lones.begin(), lones.end());
+    seeds.insert(seeds.end(), smalls.begin(), smalls.end());
+    std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
     constexpr FitKindSet kRuled = fit_kind_bit(FitKind::kCylinder) | fit_kind_bit(FitKind::kCone);
-    std::vector<std::uint32_t> mark(drafts.size(), kNone);
+    constexpr std::size_t kConeVertices = kMinVertices[static_cast<int>(FitKind::kCone)];
+    std::vector<std::uint32_t> mark(drafts.size(), kNone);  // the last seed that met it
     for (const std::uint32_t s : seeds) {
-        if (!drafts[s].alive || (!lone(s) && !ruled(s))) continue;
+        if (!drafts[s].alive) continue;
+        const bool trusting = small(s);
         const std::optional<FitKind> first =
             ruled(s) ? std::optional<FitKind>(drafts[s].surface.kind) : std::nullopt;
-        std::vector<std::uint32_t> faces = drafts[s].faces, group{s}, frontier;
+        std::vector<std::uint32_t> faces = drafts[s].faces, group{s};
+        // Lowest index first: the same order whatever the threads.
+        std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, std::greater<>> frontier;
         mark[s] = s;
         const auto reach = [&](std::span<const std::uint32_t> from) {
             for (const std::uint32_t f : from) {
                 for (const std::uint32_t g : c.fd.adj[f]) {
                     if (g == kNone) continue;
                     const std::uint32_t n = region[g];
-                    if (n == kNone || mark[n] == s || !lone(n)) continue;
+                    if (n == kNone || mark[n] == s || !small(n)) continue;
                     mark[n] = s;
-                    frontier.push_back(n);
+                    frontier.push(n);
                 }
             }
         };
         reach(faces);
-        std::optional<FitResult> best;
-        bool trusted = false;  // facets taken before a fit could check them
+        std::optional<FitResult> last;  // the fit of `faces`, once one took them
+        // The surface so far: none while on trust.
+        const auto current = [&]() -> const Surface* {
+            return last ? &last->surface : trusting ? nullptr : &drafts[s].surface;
+        };
+        // The candidate's farthest vertex from the surface so far (0 with none).
+        const auto off = [&](std::uint32_t n) {
+            const Surface* sf = current();
+            double worst = 0;
+            for (const std::uint32_t f : drafts[n].faces)
+                for (int i = 0; i < 3; ++i)
+                    if (sf)
+                        worst = std::max(worst, distance(*sf, c.m.position(c.m.vertex(fid(f), i))));
+            return worst;
+        };
         while (!frontier.empty()) {
-            const auto it = std::min_element(frontier.begin(), frontier.end());
-            const std::uint32_t n = *it;
-            frontier.erase(it);
+            const std::uint32_t n = frontier.top();
+            frontier.pop();
+            // No refit for a candidate far off the surface (as merge_regions() refuses one), nor
+            // for one a large region's surface takes as it is: that surface is known far better
+            // than the tolerance, and each refit would cost every one of its points.
+            const double worst = off(n);
+            if (worst > kHopelessTolerances * c.tol) continue;
             std::vector<std::uint32_t> more = faces;
             more.insert(more.end(), drafts[n].faces.begin(), drafts[n].faces.end());
-            if (point_count(c, more) < kMinVertices[static_cast<int>(FitKind::kCylinder)]) {
-                if (!lone(s)) continue;  // a ruled seed's own fit checks every facet
-                trusted = true;
+            std::optional<FitResult> r;
+            if (faces.size() >= kMaxGrowthRefit && current()) {
+                if (worst > c.tol || !chords_agree(c, *current(), drafts[n].faces)) continue;
+                r.emplace();
+                r->ok = true;
+                r->surface = *current();
             } else {
-                std::optional<FitResult> r = fit_faces(c, more, kRuled, first);
-                if (!r) {
-                    if (trusted && !best) break;  // what it took on trust fits nothing
-                    continue;
-                }
-                best = std::move(r);
+                r = fit_faces(c, more, kRuled, first);
+            }
+            if (r) {
+                last = std::move(r);
+            } else if (last || !trusting || point_count(c, more) >= kConeVertices) {
+                continue;  // (a small seed's trusted facets that nothing fits keep it from growing)
             }
             group.push_back(n);
             faces = std::move(more);
             reach(drafts[n].faces);
         }
-        // (Facets are taken on trust only before the first fit: best fits them all.)
-        if (!best || group.size() < 2) continue;
+        // On trust only while nothing fitted: `last` took every facet, if any fit did.
+        if (!last) continue;
         std::sort(faces.begin(), faces.end());
         for (std::size_t i = 1; i < group.size(); ++i) {
             for (const std::uint32_t f : drafts[group[i]].faces) region[f] = s;
@@ -2405,7 +2431,7 @@ std::vector<std::uint32_t> merge_fans(Context& c, std::vector<Draft>& drafts) {
             drafts[group[i]].faces.clear();
         }
         drafts[s].faces = std::move(faces);
-        drafts[s].surface = best->surface;
+        drafts[s].surface = last->surface;
         grown.push_back(s);
     }
     return grown;
