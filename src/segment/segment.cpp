@@ -2323,7 +2323,8 @@ std::size_t point_count(const Context& c, std::span<const std::uint32_t> faces) 
 /// small region) takes its small neighbours (a facet, or a cylinder or cone of at most
 /// kFanPieceFacets), across any edge and lowest index first, while a cylinder or cone fits the
 /// union within the tolerance with its facets as chords (fit_faces()). A small seed takes them
-/// on trust until a cone could be fitted (7 vertices), and keeps nothing no fit has taken. A
+/// on trust until a cone could be fitted (7 vertices), and keeps nothing no fit has taken (but
+/// a fan of three facets, which a cylinder fits with its normals for the spare data). A
 /// two-facet plane is never a member: a prism's sides lie on their circumscribed cylinder, and a
 /// many-sided one's sides sag less than the deflection; a planar face of a CAD tessellation is
 /// rarely one facet. Returns the regions that grew.
@@ -2421,6 +2422,17 @@ std::vector<std::uint32_t> merge_fans(Context& c, std::vector<Draft>& drafts) {
             group.push_back(n);
             faces = std::move(more);
             reach(drafts[n].faces);
+        }
+        // A fan of three facets (a fillet from rim to rim in three slivers) has five vertices,
+        // one fewer than a cylinder needs for a spare one; its facets' normals and middles
+        // (chords_agree()) are what test the cylinder then: the AP242 FTC 08 mesh's fillets
+        // of 3.048 mm, 42 mm long, come out at 3.048 mm.
+        if (!last && trusting && group.size() >= 3 &&
+            point_count(c, faces) == kMinVertices[static_cast<int>(FitKind::kCylinder)] - 1) {
+            PointSet ps;
+            c.gatherers.local().gather(c.m, c.fd, faces, ps);
+            FitResult r = fit(FitKind::kCylinder, ps.input());
+            if (r.ok && r.max <= c.tol && chords_agree(c, r.surface, faces)) last = std::move(r);
         }
         // On trust only while nothing fitted: `last` took every facet, if any fit did.
         if (!last) continue;
