@@ -2239,6 +2239,102 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
     return merged;
 }
 
+/// Analytic pieces along a free-form face: a piece of a blend fits a cylinder, torus or cone of
+/// its own within the tolerance where the tolerance is far below the deflection (the link
+/// rods: 0.00056 mm against 0.0054), and merge_loose_pieces() groups such pieces into a new
+/// B-spline but never gives one to a B-spline region already there. So a B-spline region
+/// (largest first; not a thread's flank) takes its smoothly joined neighbours that are loose
+/// (an RMS residual above kLooseRms x the deflection: no exact analytic face),
+/// lowest index first, while one B-spline refitted to them all holds them within the
+/// deflection with their facets as its chords (fit_group(), as the groups are held) and the
+/// piece's middles within the deflection. Not a piece of one or two facets whose fit is exact:
+/// a coarse mesh's small planar face beside a free-form one (shallow_freeform's, 46 facets in
+/// all) would go. Returns the regions that grew.
+std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts,
+                                          const std::vector<Region>& fitted) {
+    std::vector<std::uint32_t> grown;
+    const auto freeform = [&](std::uint32_t r) {
+        const Draft& d = drafts[r];
+        return d.alive && d.surface_index < 0 && d.surface.kind == FitKind::kBSpline &&
+               d.surface.bspline && !d.surface.bspline->helical;
+    };
+    std::vector<std::uint32_t> seeds;
+    for (std::uint32_t r = 0; r < drafts.size(); ++r)
+        if (freeform(r)) seeds.push_back(r);
+    if (seeds.empty()) return grown;
+    // A piece: analytic, as the final fit left it (fitted[] is that fit, for a region no earlier
+    // step of finish() changed: those are B-splines or loose now, or dead).
+    const auto piece = [&](std::uint32_t r) {
+        const Draft& d = drafts[r];
+        if (!d.alive || d.surface_index >= 0 || d.loose > 0 || d.faces.empty() ||
+            d.surface.kind == FitKind::kBSpline || !fitted[r].fit.ok ||
+            fitted[r].fit.surface.kind == FitKind::kBSpline || fitted[r].facets != d.faces.size())
+            return false;
+        return fitted[r].fit.rms > kLooseRms * c.sag;
+    };
+    std::stable_sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return drafts[a].faces.size() > drafts[b].faces.size();
+    });
+    std::vector<std::uint32_t> region = region_of_faces(c.m, drafts);
+    std::vector<std::uint32_t> mark(drafts.size(), kNone);
+    for (const std::uint32_t s : seeds) {
+        if (!freeform(s)) continue;
+        std::vector<std::uint32_t> faces = drafts[s].faces, group{s};
+        std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, std::greater<>> frontier;
+        mark[s] = s;
+        const auto reach = [&](std::span<const std::uint32_t> from) {
+            for (const std::uint32_t f : from) {
+                for (std::uint32_t i = 0; i < 3; ++i) {
+                    const std::uint32_t g = c.fd.adj[f][i];
+                    if (g == kNone || c.sharp_edge[3 * f + i]) continue;
+                    const std::uint32_t n = region[g];
+                    if (n == kNone || mark[n] == s || !piece(n)) continue;
+                    mark[n] = s;
+                    frontier.push(n);
+                }
+            }
+        };
+        reach(faces);
+        std::optional<FitResult> last;
+        while (!frontier.empty()) {
+            const std::uint32_t n = frontier.top();
+            frontier.pop();
+            std::vector<std::uint32_t> more = faces;
+            more.insert(more.end(), drafts[n].faces.begin(), drafts[n].faces.end());
+            std::vector<std::uint32_t> with = group;
+            with.push_back(n);
+            const Pieces whole = measure_pieces(c, drafts, with);
+            FitResult r = fit_group(c, more, whole);
+            if (!r.ok || !chords_agree(c, r.surface, more) ||
+                (r.surface.bspline->extruded && !extrusion_pays(r, whole)))
+                continue;
+            // The piece's facets within the deflection at their middles too, not the twice a
+            // B-spline's chords may sag: a net stretched over pieces at its border bulged
+            // between their vertices (the link rods' solid 2.4 deflections from the mesh).
+            const auto& pf = drafts[n].faces;
+            if (std::any_of(pf.begin(), pf.end(), [&](std::uint32_t f) {
+                    return distance(r.surface, c.fd.centroid[f]) > c.sag;
+                }))
+                continue;
+            last = std::move(r);
+            group = std::move(with);
+            faces = std::move(more);
+            reach(drafts[n].faces);
+        }
+        if (!last) continue;
+        std::sort(faces.begin(), faces.end());
+        for (std::size_t i = 1; i < group.size(); ++i) {
+            for (const std::uint32_t f : drafts[group[i]].faces) region[f] = s;
+            drafts[group[i]].alive = false;
+            drafts[group[i]].faces.clear();
+        }
+        drafts[s].faces = std::move(faces);
+        drafts[s].surface = last->surface;
+        grown.push_back(s);
+    }
+    return grown;
+}
+
 /// Adjacent regions of one kind (cylinder, cone, sphere) that one surface of that kind holds
 /// within the tolerance (or as loosely as either was held) but for vertices on its chords
 /// (chord_fit()) are one region, held so (Draft::loose): a faceted cut in pieces, each fitted
@@ -2783,6 +2879,7 @@ double finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRec
     if (loose) {
         std::vector<std::uint32_t> merged = merge_loose_pieces(c, drafts, fitted);
         result.freeform_groups += merged.size();
+        for (const std::uint32_t g : widen_freeform(c, drafts, fitted)) merged.push_back(g);
         for (const std::uint32_t g : merge_chords(c, drafts)) merged.push_back(g);
         for (const std::uint32_t g : merge_fans(c, drafts)) merged.push_back(g);
         for (const std::uint32_t g : grow_loose(c, drafts)) merged.push_back(g);
