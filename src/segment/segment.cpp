@@ -2303,11 +2303,32 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
             more.insert(more.end(), drafts[n].faces.begin(), drafts[n].faces.end());
             std::vector<std::uint32_t> with = group;
             with.push_back(n);
-            const Pieces whole = measure_pieces(c, drafts, with);
-            FitResult r = fit_group(c, more, whole);
-            if (!r.ok || !chords_agree(c, r.surface, more) ||
-                (r.surface.bspline->extruded && !extrusion_pays(r, whole)))
-                continue;
+            FitResult r;
+            if (faces.size() >= kMaxGrowthRefit) {
+                // A large region's surface is known far better than the deflection, and a refit
+                // costs every one of its points (0.25 s for 29k facets of trimesh_featuretype's
+                // spline wall, three times over): the piece joins it as it is, or not at all.
+                const Surface& so_far = last ? last->surface : drafts[s].surface;
+                const auto& pf = drafts[n].faces;
+                if (!std::all_of(pf.begin(), pf.end(),
+                                 [&](std::uint32_t f) {
+                                     for (int i = 0; i < 3; ++i)
+                                         if (distance(so_far, c.m.position(c.m.vertex(fid(f), i))) >
+                                             c.sag)
+                                             return false;
+                                     return true;
+                                 }) ||
+                    !chords_agree(c, so_far, pf))
+                    continue;
+                r.ok = true;
+                r.surface = so_far;
+            } else {
+                const Pieces whole = measure_pieces(c, drafts, with);
+                r = fit_group(c, more, whole);
+                if (!r.ok || !chords_agree(c, r.surface, more) ||
+                    (r.surface.bspline->extruded && !extrusion_pays(r, whole)))
+                    continue;
+            }
             // The piece's facets within the deflection at their middles too, not the twice a
             // B-spline's chords may sag: a net stretched over pieces at its border bulged
             // between their vertices (the link rods' solid 2.4 deflections from the mesh).
