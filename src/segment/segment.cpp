@@ -2243,16 +2243,22 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
 /// its own within the tolerance where the tolerance is far below the deflection (the link
 /// rods: 0.00056 mm against 0.0054), and merge_loose_pieces() groups such pieces into a new
 /// B-spline but never gives one to a B-spline region already there. So a B-spline region
-/// (largest first; not a thread's flank) takes its smoothly joined neighbours that are loose
-/// (an RMS residual above kLooseRms x the deflection: no exact analytic face),
-/// lowest index first, while one B-spline refitted to them all holds them within the
+/// (largest first; not a thread's flank) takes its smoothly joined neighbours that are loose (a
+/// final fit whose RMS is above kLooseRms x the deflection: one its surface does not hold to
+/// rounding), lowest index first, while one B-spline refitted to them all holds them within the
 /// deflection with their facets as its chords (fit_group(), as the groups are held) and the
-/// piece's middles within the deflection. Not a piece of one or two facets whose fit is exact:
-/// a coarse mesh's small planar face beside a free-form one (shallow_freeform's, 46 facets in
-/// all) would go. Returns the regions that grew.
+/// piece's middles within the deflection. A region of kMaxGrowthRefit facets or more is not
+/// refitted: its surface takes the piece as it is (vertices and middles within the deflection,
+/// its chords) or not at all. Not a piece of one or two facets whose fit is exact: a coarse
+/// mesh's small planar face beside a free-form one (shallow_freeform's, 46 facets in all) would
+/// go. `changed`: the regions merge_loose_pieces() made, whose `fitted` fits are stale.
+/// Returns the regions that grew.
 std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts,
-                                          const std::vector<Region>& fitted) {
+                                          const std::vector<Region>& fitted,
+                                          std::span<const std::uint32_t> changed) {
     std::vector<std::uint32_t> grown;
+    std::vector<std::uint8_t> stale(drafts.size(), 0);
+    for (const std::uint32_t r : changed) stale[r] = 1;
     const auto freeform = [&](std::uint32_t r) {
         const Draft& d = drafts[r];
         return d.alive && d.surface_index < 0 && d.surface.kind == FitKind::kBSpline &&
@@ -2262,15 +2268,22 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
     for (std::uint32_t r = 0; r < drafts.size(); ++r)
         if (freeform(r)) seeds.push_back(r);
     if (seeds.empty()) return grown;
-    // A piece: analytic, as the final fit left it (fitted[] is that fit, for a region no earlier
-    // step of finish() changed: those are B-splines or loose now, or dead).
+    // A piece: analytic as its final fit left it.
     const auto piece = [&](std::uint32_t r) {
         const Draft& d = drafts[r];
-        if (!d.alive || d.surface_index >= 0 || d.loose > 0 || d.faces.empty() ||
+        if (!d.alive || stale[r] || d.surface_index >= 0 || d.loose > 0 || d.faces.empty() ||
             d.surface.kind == FitKind::kBSpline || !fitted[r].fit.ok ||
-            fitted[r].fit.surface.kind == FitKind::kBSpline || fitted[r].facets != d.faces.size())
+            fitted[r].fit.surface.kind == FitKind::kBSpline)
             return false;
         return fitted[r].fit.rms > kLooseRms * c.sag;
+    };
+    // A region's vertices: their number and the sum of their squared residuals from `s`.
+    const auto misfit = [&](std::span<const std::uint32_t> faces, const Surface& sf) {
+        PointSet own;
+        c.gatherers.local().gather(c.m, c.fd, faces, own);
+        const FitResult r = residuals(sf, FitInput{own.points, own.normals, {}});
+        const auto np = static_cast<double>(own.points.size());
+        return std::make_pair(np, r.rms * r.rms * np);
     };
     std::stable_sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
         return drafts[a].faces.size() > drafts[b].faces.size();
@@ -2279,6 +2292,14 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
     std::vector<std::uint32_t> mark(drafts.size(), kNone);
     for (const std::uint32_t s : seeds) {
         if (!freeform(s)) continue;
+        const bool large = drafts[s].faces.size() >= kMaxGrowthRefit;
+        // The surface so far: the final fit's where it is the region's (it may have replaced
+        // the draft's), else the draft's.
+        Surface so_far = !stale[s] && fitted[s].fit.ok &&
+                                 fitted[s].fit.surface.kind == FitKind::kBSpline &&
+                                 fitted[s].facets == drafts[s].faces.size()
+                             ? fitted[s].fit.surface
+                             : drafts[s].surface;
         std::vector<std::uint32_t> faces = drafts[s].faces, group{s};
         std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, std::greater<>> frontier;
         mark[s] = s;
@@ -2295,54 +2316,62 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
             }
         };
         reach(faces);
-        std::optional<FitResult> last;
+        // The group's pieces together (measure_pieces(), kept as they grow: the seed's
+        // points are measured once).
+        Pieces whole{free_parameters(so_far), 0};
+        double points = 0, squares = 0;
+        if (!large) std::tie(points, squares) = misfit(faces, so_far);
+        bool grew = false;
         while (!frontier.empty()) {
             const std::uint32_t n = frontier.top();
             frontier.pop();
+            const auto& pf = drafts[n].faces;
             std::vector<std::uint32_t> more = faces;
-            more.insert(more.end(), drafts[n].faces.begin(), drafts[n].faces.end());
-            std::vector<std::uint32_t> with = group;
-            with.push_back(n);
+            more.insert(more.end(), pf.begin(), pf.end());
             FitResult r;
-            if (faces.size() >= kMaxGrowthRefit) {
+            Pieces with = whole;
+            double more_points = points, more_squares = squares;
+            if (large) {
                 // A large region's surface is known far better than the deflection, and a refit
                 // costs every one of its points (0.25 s for 29k facets of trimesh_featuretype's
-                // spline wall, three times over): the piece joins it as it is, or not at all.
-                const Surface& so_far = last ? last->surface : drafts[s].surface;
-                const auto& pf = drafts[n].faces;
-                if (!std::all_of(pf.begin(), pf.end(),
-                                 [&](std::uint32_t f) {
-                                     for (int i = 0; i < 3; ++i)
-                                         if (distance(so_far, c.m.position(c.m.vertex(fid(f), i))) >
-                                             c.sag)
-                                             return false;
-                                     return true;
-                                 }) ||
-                    !chords_agree(c, so_far, pf))
-                    continue;
+                // spline wall, three times over).
+                const bool on = std::all_of(pf.begin(), pf.end(), [&](std::uint32_t f) {
+                    for (int i = 0; i < 3; ++i)
+                        if (distance(so_far, c.m.position(c.m.vertex(fid(f), i))) > c.sag)
+                            return false;
+                    return true;
+                });
+                if (!on || !chords_agree(c, so_far, pf)) continue;
                 r.ok = true;
                 r.surface = so_far;
             } else {
-                const Pieces whole = measure_pieces(c, drafts, with);
-                r = fit_group(c, more, whole);
+                const auto [np, sq] = misfit(pf, drafts[n].surface);
+                more_points += np;
+                more_squares += sq;
+                with.parameters += free_parameters(drafts[n].surface);
+                with.rms = more_points > 0 ? std::sqrt(more_squares / more_points) : 0;
+                r = fit_group(c, more, with);
                 if (!r.ok || !chords_agree(c, r.surface, more) ||
-                    (r.surface.bspline->extruded && !extrusion_pays(r, whole)))
+                    (r.surface.bspline->extruded && !extrusion_pays(r, with)))
                     continue;
             }
             // The piece's facets within the deflection at their middles too, not the twice a
             // B-spline's chords may sag: a net stretched over pieces at its border bulged
             // between their vertices (the link rods' solid 2.4 deflections from the mesh).
-            const auto& pf = drafts[n].faces;
             if (std::any_of(pf.begin(), pf.end(), [&](std::uint32_t f) {
                     return distance(r.surface, c.fd.centroid[f]) > c.sag;
                 }))
                 continue;
-            last = std::move(r);
-            group = std::move(with);
+            so_far = r.surface;
+            whole = with;
+            points = more_points;
+            squares = more_squares;
+            grew = true;
+            group.push_back(n);
             faces = std::move(more);
-            reach(drafts[n].faces);
+            reach(pf);
         }
-        if (!last) continue;
+        if (!grew) continue;
         std::sort(faces.begin(), faces.end());
         for (std::size_t i = 1; i < group.size(); ++i) {
             for (const std::uint32_t f : drafts[group[i]].faces) region[f] = s;
@@ -2350,7 +2379,7 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
             drafts[group[i]].faces.clear();
         }
         drafts[s].faces = std::move(faces);
-        drafts[s].surface = last->surface;
+        drafts[s].surface = so_far;
         grown.push_back(s);
     }
     return grown;
@@ -2541,15 +2570,23 @@ std::vector<std::uint32_t> merge_fans(Context& c, std::vector<Draft>& drafts) {
             reach(drafts[n].faces);
         }
         // A fan of three facets (a fillet from rim to rim in three slivers) has five vertices,
-        // one fewer than a cylinder needs for a spare one; its facets' normals and middles
-        // (chords_agree()) are what test the cylinder then: the AP242 FTC 08 mesh's fillets
-        // of 3.048 mm, 42 mm long, come out at 3.048 mm.
-        if (!last && trusting && group.size() >= 3 &&
+        // one fewer than a cylinder needs for a spare one: any five points fit some cylinder.
+        // What tests it then is the facets: their middles within the deflection and their
+        // normals across its axis (within kStripLean, as an extrusion's), which a fan's
+        // slivers along the axis have and a corner's facets do not. The AP242 FTC 08 mesh's
+        // fillets of 3.048 mm, 42 mm long, come out at 3.048 mm.
+        if (!last && trusting && faces.size() == 3 &&
             point_count(c, faces) == kMinVertices[static_cast<int>(FitKind::kCylinder)] - 1) {
             PointSet ps;
             c.gatherers.local().gather(c.m, c.fd, faces, ps);
-            FitResult r = fit(FitKind::kCylinder, ps.input());
-            if (r.ok && r.max <= c.tol && chords_agree(c, r.surface, faces)) last = std::move(r);
+            FitInput in = ps.input();
+            in.accept = c.tol;
+            FitResult r = fit(FitKind::kCylinder, in);
+            const bool across = std::all_of(faces.begin(), faces.end(), [&](std::uint32_t f) {
+                return std::abs(dot(c.fd.normal[f], r.surface.axis)) <= kStripLean;
+            });
+            if (r.ok && r.max <= c.tol && across && chords_agree(c, r.surface, faces))
+                last = std::move(r);
         }
         // On trust only while nothing fitted: `last` took every facet, if any fit did.
         if (!last) continue;
@@ -2900,7 +2937,7 @@ double finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRec
     if (loose) {
         std::vector<std::uint32_t> merged = merge_loose_pieces(c, drafts, fitted);
         result.freeform_groups += merged.size();
-        for (const std::uint32_t g : widen_freeform(c, drafts, fitted)) merged.push_back(g);
+        for (const std::uint32_t g : widen_freeform(c, drafts, fitted, merged)) merged.push_back(g);
         for (const std::uint32_t g : merge_chords(c, drafts)) merged.push_back(g);
         for (const std::uint32_t g : merge_fans(c, drafts)) merged.push_back(g);
         for (const std::uint32_t g : grow_loose(c, drafts)) merged.push_back(g);
