@@ -2239,6 +2239,22 @@ std::vector<std::uint32_t> merge_loose_pieces(Context& c, std::vector<Draft>& dr
     return merged;
 }
 
+/// The first region of `group` takes the others: their facets relabelled in `region`, they die,
+/// and it has `faces` (sorted here) on `surface`.
+void take_group(std::vector<Draft>& drafts, std::vector<std::uint32_t>& region,
+                std::span<const std::uint32_t> group, std::vector<std::uint32_t> faces,
+                const Surface& surface) {
+    const std::uint32_t s = group.front();
+    std::sort(faces.begin(), faces.end());
+    for (std::size_t i = 1; i < group.size(); ++i) {
+        for (const std::uint32_t f : drafts[group[i]].faces) region[f] = s;
+        drafts[group[i]].alive = false;
+        drafts[group[i]].faces.clear();
+    }
+    drafts[s].faces = std::move(faces);
+    drafts[s].surface = surface;
+}
+
 /// Analytic pieces along a free-form face: a piece of a blend fits a cylinder, torus or cone of
 /// its own within the tolerance where the tolerance is far below the deflection (the link
 /// rods: 0.00056 mm against 0.0054), and merge_loose_pieces() groups such pieces into a new
@@ -2372,14 +2388,7 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
             reach(pf);
         }
         if (!grew) continue;
-        std::sort(faces.begin(), faces.end());
-        for (std::size_t i = 1; i < group.size(); ++i) {
-            for (const std::uint32_t f : drafts[group[i]].faces) region[f] = s;
-            drafts[group[i]].alive = false;
-            drafts[group[i]].faces.clear();
-        }
-        drafts[s].faces = std::move(faces);
-        drafts[s].surface = so_far;
+        take_group(drafts, region, group, std::move(faces), so_far);
         grown.push_back(s);
     }
     return grown;
@@ -2590,14 +2599,7 @@ std::vector<std::uint32_t> merge_fans(Context& c, std::vector<Draft>& drafts) {
         }
         // On trust only while nothing fitted: `last` took every facet, if any fit did.
         if (!last) continue;
-        std::sort(faces.begin(), faces.end());
-        for (std::size_t i = 1; i < group.size(); ++i) {
-            for (const std::uint32_t f : drafts[group[i]].faces) region[f] = s;
-            drafts[group[i]].alive = false;
-            drafts[group[i]].faces.clear();
-        }
-        drafts[s].faces = std::move(faces);
-        drafts[s].surface = last->surface;
+        take_group(drafts, region, group, std::move(faces), last->surface);
         grown.push_back(s);
     }
     return grown;
