@@ -308,14 +308,21 @@ bool normal_agrees(const Context& c, const Surface& s, std::uint32_t f) {
     return cos_mid >= cos_span;
 }
 
+/// The largest distance of a corner of `faces` from `s`.
+double farthest_corner(const Context& c, const Surface& s, std::span<const std::uint32_t> faces) {
+    double worst = 0;
+    for (const std::uint32_t f : faces)
+        for (int i = 0; i < 3; ++i)
+            worst = std::max(worst, distance(s, c.m.position(c.m.vertex(fid(f), i))));
+    return worst;
+}
+
 /// How badly facet f fits s: the largest distance of its corners; infinite when its normal
 /// disagrees with the surface's or its middle is further from the surface than
 /// kMiddleSagFactor chordal deflections (a chord of the surface: corners on it, middle within
 /// the sag).
 double facet_cost(const Context& c, const Surface& s, std::uint32_t f, bool check_normal = true) {
-    double worst = 0;
-    for (int i = 0; i < 3; ++i)
-        worst = std::max(worst, distance(s, c.m.position(c.m.vertex(fid(f), i))));
+    const double worst = farthest_corner(c, s, std::span(&f, 1));
     if (worst > c.tol) return worst;
     if (distance(s, c.fd.centroid[f]) > kMiddleSagFactor * c.sag) return kInf;
     return !check_normal || normal_agrees(c, s, f) ? worst : kInf;
@@ -1176,25 +1183,36 @@ std::size_t free_parameters(const Surface& s) {
     return s.bspline->extruded ? 2 * nu + 2 : nu * nv;
 }
 
-/// Regions' free parameters together and the RMS residual of their vertices from their surfaces.
+/// The residuals of the vertices of `faces` from `s` (unweighted); `points` receives how many
+/// vertices they are.
+FitResult residuals_of(Context& c, std::span<const std::uint32_t> faces, const Surface& s,
+                       double* points = nullptr) {
+    PointSet own;
+    c.gatherers.local().gather(c.m, c.fd, faces, own);
+    if (points) *points = static_cast<double>(own.points.size());
+    return residuals(s, FitInput{own.points, own.normals, {}});
+}
+
+/// Regions' free parameters together and the RMS residual of their vertices from their surfaces
+/// (over `points` vertices).
 struct Pieces {
     std::size_t parameters = 0;
     double rms = 0;
+    double points = 0;
+    /// With a region of `faces` on `s` too.
+    void add(Context& c, std::span<const std::uint32_t> faces, const Surface& s) {
+        parameters += free_parameters(s);
+        double np = 0;
+        const FitResult r = residuals_of(c, faces, s, &np);
+        const double total = points + np;
+        rms = total > 0 ? std::sqrt((rms * rms * points + r.rms * r.rms * np) / total) : 0;
+        points = total;
+    }
 };
 Pieces measure_pieces(Context& c, const std::vector<Draft>& drafts,
                       std::span<const std::uint32_t> pieces) {
     Pieces out;
-    double sum = 0, count = 0;
-    for (const std::uint32_t p : pieces) {
-        out.parameters += free_parameters(drafts[p].surface);
-        PointSet own;
-        c.gatherers.local().gather(c.m, c.fd, drafts[p].faces, own);
-        const FitResult r = residuals(drafts[p].surface, FitInput{own.points, own.normals, {}});
-        const auto np = static_cast<double>(own.points.size());
-        sum += r.rms * r.rms * np;
-        count += np;
-    }
-    out.rms = count > 0 ? std::sqrt(sum / count) : 0;
+    for (const std::uint32_t p : pieces) out.add(c, drafts[p].faces, drafts[p].surface);
     return out;
 }
 
@@ -2293,14 +2311,6 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
             return false;
         return fitted[r].fit.rms > kLooseRms * c.sag;
     };
-    // A region's vertices: their number and the sum of their squared residuals from `s`.
-    const auto misfit = [&](std::span<const std::uint32_t> faces, const Surface& sf) {
-        PointSet own;
-        c.gatherers.local().gather(c.m, c.fd, faces, own);
-        const FitResult r = residuals(sf, FitInput{own.points, own.normals, {}});
-        const auto np = static_cast<double>(own.points.size());
-        return std::make_pair(np, r.rms * r.rms * np);
-    };
     std::stable_sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
         return drafts[a].faces.size() > drafts[b].faces.size();
     });
@@ -2333,39 +2343,28 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
         };
         reach(faces);
         // The group's pieces together (measure_pieces(), kept as they grow: the seed's
-        // points are measured once).
-        Pieces whole{free_parameters(so_far), 0};
-        double points = 0, squares = 0;
-        if (!large) std::tie(points, squares) = misfit(faces, so_far);
+        // points are measured once), for a refit.
+        Pieces whole;
+        if (!large) whole.add(c, faces, so_far);
         bool grew = false;
         while (!frontier.empty()) {
             const std::uint32_t n = frontier.top();
             frontier.pop();
             const auto& pf = drafts[n].faces;
-            std::vector<std::uint32_t> more = faces;
-            more.insert(more.end(), pf.begin(), pf.end());
             FitResult r;
             Pieces with = whole;
-            double more_points = points, more_squares = squares;
             if (large) {
                 // A large region's surface is known far better than the deflection, and a refit
                 // costs every one of its points (0.25 s for 29k facets of trimesh_featuretype's
                 // spline wall, three times over).
-                const bool on = std::all_of(pf.begin(), pf.end(), [&](std::uint32_t f) {
-                    for (int i = 0; i < 3; ++i)
-                        if (distance(so_far, c.m.position(c.m.vertex(fid(f), i))) > c.sag)
-                            return false;
-                    return true;
-                });
-                if (!on || !chords_agree(c, so_far, pf)) continue;
+                if (farthest_corner(c, so_far, pf) > c.sag || !chords_agree(c, so_far, pf))
+                    continue;
                 r.ok = true;
                 r.surface = so_far;
             } else {
-                const auto [np, sq] = misfit(pf, drafts[n].surface);
-                more_points += np;
-                more_squares += sq;
-                with.parameters += free_parameters(drafts[n].surface);
-                with.rms = more_points > 0 ? std::sqrt(more_squares / more_points) : 0;
+                std::vector<std::uint32_t> more = faces;
+                more.insert(more.end(), pf.begin(), pf.end());
+                with.add(c, pf, drafts[n].surface);
                 r = fit_group(c, more, with);
                 if (!r.ok || !chords_agree(c, r.surface, more) ||
                     (r.surface.bspline->extruded && !extrusion_pays(r, with)))
@@ -2380,11 +2379,9 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
                 continue;
             so_far = r.surface;
             whole = with;
-            points = more_points;
-            squares = more_squares;
             grew = true;
             group.push_back(n);
-            faces = std::move(more);
+            faces.insert(faces.end(), pf.begin(), pf.end());
             reach(pf);
         }
         if (!grew) continue;
@@ -2543,12 +2540,7 @@ std::vector<std::uint32_t> merge_fans(Context& c, std::vector<Draft>& drafts) {
         // The candidate's farthest vertex from the surface so far (0 with none).
         const auto off = [&](std::uint32_t n) {
             const Surface* sf = current();
-            double worst = 0;
-            for (const std::uint32_t f : drafts[n].faces)
-                for (int i = 0; i < 3; ++i)
-                    if (sf)
-                        worst = std::max(worst, distance(*sf, c.m.position(c.m.vertex(fid(f), i))));
-            return worst;
+            return sf ? farthest_corner(c, *sf, drafts[n].faces) : 0.0;
         };
         while (!frontier.empty()) {
             const std::uint32_t n = frontier.top();
@@ -2558,25 +2550,28 @@ std::vector<std::uint32_t> merge_fans(Context& c, std::vector<Draft>& drafts) {
             // than the tolerance, and each refit would cost every one of its points.
             const double worst = off(n);
             if (worst > kHopelessTolerances * c.tol) continue;
-            std::vector<std::uint32_t> more = faces;
-            more.insert(more.end(), drafts[n].faces.begin(), drafts[n].faces.end());
+            const auto& nf = drafts[n].faces;
             std::optional<FitResult> r;
+            bool trusted = false;
             if (faces.size() >= kMaxGrowthRefit && current()) {
-                if (worst > c.tol || !chords_agree(c, *current(), drafts[n].faces)) continue;
+                if (worst > c.tol || !chords_agree(c, *current(), nf)) continue;
                 r.emplace();
                 r->ok = true;
                 r->surface = *current();
             } else {
+                std::vector<std::uint32_t> more = faces;
+                more.insert(more.end(), nf.begin(), nf.end());
                 r = fit_faces(c, more, kRuled, first);
+                // (A small seed's trusted facets that nothing fits keep it from growing.)
+                trusted = !r && !last && trusting && point_count(c, more) < kConeVertices;
             }
-            if (r) {
+            if (r)
                 last = std::move(r);
-            } else if (last || !trusting || point_count(c, more) >= kConeVertices) {
-                continue;  // (a small seed's trusted facets that nothing fits keep it from growing)
-            }
+            else if (!trusted)
+                continue;
             group.push_back(n);
-            faces = std::move(more);
-            reach(drafts[n].faces);
+            faces.insert(faces.end(), nf.begin(), nf.end());
+            reach(nf);
         }
         // A fan of three facets (a fillet from rim to rim in three slivers) has five vertices,
         // one fewer than a cylinder needs for a spare one: any five points fit some cylinder.
@@ -2724,13 +2719,8 @@ bool vague_region(Context& c, const Draft& d, std::int8_t& known) {
         const Surface& s = d.surface;
         bool v = false;
         if (d.alive && d.surface_index < 0 && !(s.bspline && s.bspline->helical)) {
-            v = (s.kind == FitKind::kBSpline && s.bspline && !s.bspline->helical) || d.loose > 0 ||
-                d.faces.size() <= kSmallRegion;
-            if (!v) {
-                PointSet own;
-                c.gatherers.local().gather(c.m, c.fd, d.faces, own);
-                v = residuals(s, FitInput{own.points, own.normals, {}}).rms > kLooseRms * c.sag;
-            }
+            v = s.kind == FitKind::kBSpline || d.loose > 0 || d.faces.size() <= kSmallRegion ||
+                residuals_of(c, d.faces, s).rms > kLooseRms * c.sag;
         }
         known = v ? 1 : 0;
     }
@@ -2880,14 +2870,7 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
             for (const std::uint32_t p : group) tried[p] = 1;
             continue;
         }
-        std::sort(faces.begin(), faces.end());
-        drafts[s].faces = std::move(faces);
-        drafts[s].surface = best.surface;
-        for (std::size_t i = 1; i < group.size(); ++i) {
-            for (const std::uint32_t f : drafts[group[i]].faces) region[f] = s;
-            drafts[group[i]].alive = false;
-            drafts[group[i]].faces.clear();
-        }
+        take_group(drafts, region, group, std::move(faces), best.surface);
         grown.push_back(s);
         known[s] = -1;  // a helical sweep now
         // Then the flank's facets in pieces it could not take whole, when the sweep refitted
