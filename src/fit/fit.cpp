@@ -1489,14 +1489,25 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
                                                                   h(a + nu * b) * nrm;
             }
         }
-        // Residuals: true distances, projecting from each point's own parameters.
+        // Residuals: true distances, projecting from each point's own parameters (on all
+        // cores: most of the time of a large group's fit, docs/benchmarks.md), summed in order.
+        std::vector<double> dist(n);
+        const auto residuals = [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                double uu = u[i], vv = v[i];
+                project_bspline(*bs, in.points[i], uu, vv);
+                dist[i] = norm(bs->evaluate(uu, vv) - in.points[i]);
+            }
+        };
+        if (n <= kGrain) {  // one task: without the scheduler's cost
+            residuals(tbb::blocked_range<std::size_t>(0, n));
+        } else {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), residuals);
+        }
         double sum = 0, mx = 0;
         for (std::size_t i = 0; i < n; ++i) {
-            double uu = u[i], vv = v[i];
-            project_bspline(*bs, in.points[i], uu, vv);
-            const double d = norm(bs->evaluate(uu, vv) - in.points[i]);
-            sum += weight(in, i) * d * d;
-            mx = std::max(mx, d);
+            sum += weight(in, i) * dist[i] * dist[i];
+            mx = std::max(mx, dist[i]);
         }
         FitResult r = bspline_fit(std::move(bs), c, nrm, std::sqrt(sum / total), mx, nu * nv);
         best = r;

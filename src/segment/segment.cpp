@@ -811,6 +811,29 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> adjacent_pairs(
     return pairs;
 }
 
+/// Sorts a region's facet list as std::sort does, in linear time when the list is a few
+/// sorted runs: two regions' lists one after the other, and the strays a region took since.
+/// A large region takes hundreds of small neighbours one by one; sorting its whole list each
+/// time cost the turned shaft meshed to 1.4M facets 13 of its 19 s of segmentation (perf).
+void sort_facets(std::vector<std::uint32_t>& faces) {
+    // More runs than this: a list in no particular order (a grown region's), sorted outright.
+    constexpr std::size_t kMaxRuns = 8;
+    std::vector<std::size_t> ends;  // where each sorted run ends
+    for (auto it = faces.begin(); it != faces.end();) {
+        it = std::is_sorted_until(it, faces.end());
+        ends.push_back(static_cast<std::size_t>(it - faces.begin()));
+        if (ends.size() > kMaxRuns) {
+            std::sort(faces.begin(), faces.end());
+            return;
+        }
+    }
+    for (std::size_t i = 1; i < ends.size(); ++i) {
+        const auto first = faces.begin();
+        std::inplace_merge(first, first + static_cast<std::ptrdiff_t>(ends[i - 1]),
+                           first + static_cast<std::ptrdiff_t>(ends[i]));
+    }
+}
+
 std::vector<std::uint32_t> region_of_faces(const Mesh& m, const std::vector<Draft>& drafts) {
     std::vector<std::uint32_t> region(m.num_faces(), kNone);
     for (std::uint32_t r = 0; r < drafts.size(); ++r) {
@@ -1107,7 +1130,7 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
             nbrs.emplace_back();
             born.push_back(id);
         }
-        std::sort(faces.begin(), faces.end());
+        sort_facets(faces);
         drafts[keep].faces = std::move(faces);
         drafts[keep].surface = r->surface;
         drafts[gone].alive = false;
@@ -1937,7 +1960,7 @@ std::vector<std::uint32_t> live_drafts(std::vector<Draft>& drafts) {
     std::vector<std::uint32_t> order;
     for (std::uint32_t r = 0; r < drafts.size(); ++r) {
         if (drafts[r].alive && !drafts[r].faces.empty()) {
-            std::sort(drafts[r].faces.begin(), drafts[r].faces.end());
+            sort_facets(drafts[r].faces);
             order.push_back(r);
         }
     }
