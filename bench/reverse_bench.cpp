@@ -83,7 +83,8 @@ BENCHMARK(BM_Reverse)
 // trimesh_featuretype (96 faces, 79 unified, one a spline wall; ../shared/corpus) at 1e-3 of
 // its size and 1 degree (82k facets). Issue 8's target: ~100 faces from 100k facets to STEP in
 // <= 5 s. And (3) the fillet block at 0.0002 mm and 0.02 rad (345k facets): how the time grows
-// with the mesh.
+// with the mesh; (4) turned_shaft (17 faces) at 0.0003 mm and 0.01 rad (1.38M facets): a mesh
+// of millions of triangles, as a fine NC simulation writes.
 struct SurfacesCase {
     std::string name;
     TriangleSoup soup;
@@ -113,6 +114,11 @@ const SurfacesCase& surfaces_case(int which) {
         so.relative_deflection = 1e-3;
         so.angular_deflection = 0.02;
         made = corpus("trimesh_featuretype.step");
+    } else if (which == 4) {
+        c.name = "turned_shaft";
+        so.deflection = 0.0003;
+        so.angular_deflection = 0.01;
+        made = make_sample_part(c.name, so);
     } else if (which == 3) {
         c.name = "fillet_chamfer_block";
         so.deflection = 0.0002;
@@ -174,7 +180,7 @@ void BM_ReverseSurfaces(benchmark::State& state) {
     state.SetLabel(c.name + " " + to_string(options.method));
 }
 BENCHMARK(BM_ReverseSurfaces)
-    ->ArgsProduct({{0, 1, 2, 3}, {0, 1}})
+    ->ArgsProduct({{0, 1, 2, 3, 4}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
