@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -126,6 +127,9 @@ constexpr double kOrphanShare = 0.01;
 /// does, so the two are within 2 tolerances of each other there, and by little more a facet
 /// beside them; the rest is margin.
 constexpr double kHopelessTolerances = 10;
+/// Pairs merge_regions() fits ahead of their turn, at most, on all cores: a few per core (most
+/// are refused, so most fits ahead are used).
+constexpr std::size_t kFitAhead = 8;
 /// A cylinder or cone region of at most this many facets may be a piece of a coarse fan (see
 /// merge_fans()): what pairwise merging makes of two of its facets.
 constexpr std::size_t kFanPieceFacets = 2;
@@ -944,28 +948,16 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
                    version[b], false);
     };
     for (const auto& [a, b] : pairs) push(a, b);
-    std::uint64_t merges = 0;
-    std::vector<Surface> misses;
-    std::vector<std::uint32_t> strays;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> homes;  // (stray facet, its region)
-    std::vector<std::uint32_t> orphans;                          // strays no neighbour takes
-    std::vector<Draft> groups;                                   // ... as new regions
-    while (!pq.empty()) {
-        const auto [cost, a, b, va, vb, exact] = pq.top();
-        pq.pop();
-        if (!drafts[a].alive || !drafts[b].alive || version[a] != va || version[b] != vb) continue;
-        if (!exact) {
-            pq.emplace(unlikeness(c, drafts[a], drafts[b]), a, b, va, vb, true);
-            continue;
-        }
-        // Fragments: every pair left is one neither of whose surfaces takes the other.
-        if (fragments && cost > c.tol) break;
+    const auto union_of = [&](std::uint32_t a, std::uint32_t b) {
         std::vector<std::uint32_t> faces = drafts[a].faces;
         faces.insert(faces.end(), drafts[b].faces.begin(), drafts[b].faces.end());
-        // A much larger region keeps its kind (and may take a firm plane that is its chords: a
-        // coarse cone's strip between two generators is exactly planar). Between regions of
-        // like size a firm plane keeps its kind: a plane does not become a torus of large
-        // radius to take in the fillet beside it, which the tolerance allows.
+        return faces;
+    };
+    // A much larger region keeps its kind (and may take a firm plane that is its chords: a
+    // coarse cone's strip between two generators is exactly planar). Between regions of like
+    // size a firm plane keeps its kind: a plane does not become a torus of large radius to take
+    // in the fillet beside it, which the tolerance allows.
+    const auto union_kinds = [&](std::uint32_t a, std::uint32_t b) {
         const std::size_t na = drafts[a].faces.size(), nb = drafts[b].faces.size();
         FitKindSet kinds = kRevolutionFitKinds;
         if (na >= kDominantRatio * nb) {
@@ -976,11 +968,105 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
             if (firm_plane(c, drafts[a])) kinds = fit_kind_bit(drafts[a].surface.kind);
             if (firm_plane(c, drafts[b])) kinds &= fit_kind_bit(drafts[b].surface.kind);
         }
+        return kinds;
+    };
+    const auto union_sag = [&](std::uint32_t a, std::uint32_t b) {
+        return std::min(drafts[a].faces.size(), drafts[b].faces.size()) <= kLooseFacets
+                   ? RuledSag::kTwice
+                   : RuledSag::kDeflection;
+    };
+    // Most pairs that come up are refused, each after one or two refits of their union, and a
+    // refit depends on nothing but the two regions as they are (their versions). So the next
+    // pairs of the queue are fitted on all cores ahead of their turn (kFitAhead at a time), and
+    // a pair takes its result when it comes up with both versions unchanged: the same results
+    // in the same order as fitting each in turn. (The freeform die at 159k facets refits
+    // 4.1M facets in 1836 unions, 324 taken; docs/benchmarks.md.)
+    struct Ahead {
+        std::optional<FitResult> fit;
+        std::vector<Surface> misses;
+        bool without_strays_tried = false;
+        std::optional<FitResult> without_strays;
+        std::vector<std::uint32_t> strays;
+    };
+    using Key = std::tuple<std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>;
+    std::map<Key, Ahead> fitted_ahead;
+    const auto fit_ahead = [&] {
+        std::vector<Item> next;
+        while (!pq.empty() && next.size() < kFitAhead) {
+            const Item it = pq.top();
+            const auto [cost, a, b, va, vb, exact] = it;
+            if (!drafts[a].alive || !drafts[b].alive || version[a] != va || version[b] != vb) {
+                pq.pop();  // stale: dropped when it came up, as now
+                continue;
+            }
+            pq.pop();
+            if (!exact) {  // its exact cost now, as when it came up (the same regions)
+                pq.emplace(unlikeness(c, drafts[a], drafts[b]), a, b, va, vb, true);
+                continue;
+            }
+            next.push_back(it);
+        }
+        // Fitted in batches: once the next pair's fit is missing, the missing ones of the next
+        // kFitAhead together (one at a time would leave a core idle).
+        const bool batch =
+            !next.empty() &&
+            !fitted_ahead.count({std::get<1>(next.front()), std::get<2>(next.front()),
+                                 std::get<3>(next.front()), std::get<4>(next.front())});
+        std::vector<Key> todo;
+        for (const Item& it : next) {
+            pq.push(it);
+            if (!batch) continue;
+            const auto [cost, a, b, va, vb, exact] = it;
+            const Key key{a, b, va, vb};
+            if (fitted_ahead.count(key)) continue;
+            // The pairs the large-region rule decides without a refit, in turn.
+            const std::uint32_t big = drafts[a].faces.size() >= drafts[b].faces.size() ? a : b;
+            const std::uint32_t small = big == a ? b : a;
+            if (drafts[big].faces.size() >= kDominantRatio * drafts[small].faces.size() &&
+                drafts[big].faces.size() >= kMaxGrowthRefit)
+                continue;
+            todo.push_back(key);
+        }
+        if (todo.size() < 2) return;  // one: fitted in turn, as before
+        std::vector<Ahead> done(todo.size());
+        tbb::parallel_for(std::size_t{0}, todo.size(), [&](std::size_t k) {
+            const auto [a, b, va, vb] = todo[k];
+            const std::vector<std::uint32_t> faces = union_of(a, b);
+            Ahead& d = done[k];
+            d.fit =
+                fit_faces(c, faces, union_kinds(a, b), std::nullopt, &d.misses, union_sag(a, b));
+            if (!d.fit && !d.misses.empty()) {
+                d.without_strays_tried = true;
+                d.without_strays = fit_without_strays(c, faces, d.misses, d.strays);
+            }
+        });
+        for (std::size_t k = 0; k < todo.size(); ++k)
+            fitted_ahead.emplace(todo[k], std::move(done[k]));
+    };
+    std::uint64_t merges = 0;
+    std::vector<Surface> misses;
+    std::vector<std::uint32_t> strays;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> homes;  // (stray facet, its region)
+    std::vector<std::uint32_t> orphans;                          // strays no neighbour takes
+    std::vector<Draft> groups;                                   // ... as new regions
+    while (!pq.empty()) {
+        if (!fragments) fit_ahead();
+        const auto [cost, a, b, va, vb, exact] = pq.top();
+        pq.pop();
+        if (!drafts[a].alive || !drafts[b].alive || version[a] != va || version[b] != vb) continue;
+        if (!exact) {
+            pq.emplace(unlikeness(c, drafts[a], drafts[b]), a, b, va, vb, true);
+            continue;
+        }
+        // Fragments: every pair left is one neither of whose surfaces takes the other.
+        if (fragments && cost > c.tol) break;
+        std::vector<std::uint32_t> faces = union_of(a, b);
+        const std::size_t na = drafts[a].faces.size(), nb = drafts[b].faces.size();
+        const FitKindSet kinds = union_kinds(a, b);
         misses.clear();
         homes.clear();
         groups.clear();
-        const RuledSag ruled_sag =
-            std::min(na, nb) <= kLooseFacets ? RuledSag::kTwice : RuledSag::kDeflection;
+        const RuledSag ruled_sag = union_sag(a, b);
         std::optional<FitResult> r;
         // A dominant region of kMaxGrowthRefit facets or more (its surface known far better
         // than the tolerance: growing refits no larger region) and a small
@@ -1014,7 +1100,14 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
                 r->surface = sb;
             }
         }
-        if (!r) r = fit_faces(c, faces, kinds, std::nullopt, &misses, ruled_sag);
+        const auto ahead = fitted_ahead.find({a, b, va, vb});
+        const bool known = ahead != fitted_ahead.end();
+        if (!r && known) {
+            r = ahead->second.fit;
+            misses = ahead->second.misses;
+        } else if (!r) {
+            r = fit_faces(c, faces, kinds, std::nullopt, &misses, ruled_sag);
+        }
         if (!r && fragments) {
             // A fragment joins its neighbour as it is when its facets are chords of the other's
             // surface: the union's fit holds the fans of a coarse fillet, which sag beyond the
@@ -1045,7 +1138,12 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
             }
         }
         if (!r && !misses.empty()) {
-            r = fit_without_strays(c, faces, misses, strays);
+            if (known && ahead->second.without_strays_tried) {
+                r = ahead->second.without_strays;
+                strays = ahead->second.strays;
+            } else {
+                r = fit_without_strays(c, faces, misses, strays);
+            }
             // Strays are a few facets of one of the two, never the better part of either
             // (a region whose every facet fits elsewhere is not merged by leaving it out).
             double from_a = 0, from_b = 0, area_a = 0, area_b = 0;
