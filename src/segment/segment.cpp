@@ -997,6 +997,7 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
             const auto [cost, a, b, va, vb, exact] = it;
             if (!drafts[a].alive || !drafts[b].alive || version[a] != va || version[b] != vb) {
                 pq.pop();  // stale: dropped when it came up, as now
+                fitted_ahead.erase({a, b, va, vb});
                 continue;
             }
             pq.pop();
@@ -1050,7 +1051,10 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
     std::vector<std::uint32_t> orphans;                          // strays no neighbour takes
     std::vector<Draft> groups;                                   // ... as new regions
     while (!pq.empty()) {
-        if (!fragments) fit_ahead();
+        if (!fragments) {
+            fit_ahead();
+            if (pq.empty()) break;  // it found only stale pairs
+        }
         const auto [cost, a, b, va, vb, exact] = pq.top();
         pq.pop();
         if (!drafts[a].alive || !drafts[b].alive || version[a] != va || version[b] != vb) continue;
@@ -1100,11 +1104,16 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
                 r->surface = sb;
             }
         }
-        const auto ahead = fitted_ahead.find({a, b, va, vb});
-        const bool known = ahead != fitted_ahead.end();
+        // Its fit ahead, if any (taken out: an entry serves once, so the map stays small).
+        std::optional<Ahead> ahead;
+        if (const auto it = fitted_ahead.find({a, b, va, vb}); it != fitted_ahead.end()) {
+            ahead = std::move(it->second);
+            fitted_ahead.erase(it);
+        }
+        const bool known = ahead.has_value();
         if (!r && known) {
-            r = ahead->second.fit;
-            misses = ahead->second.misses;
+            r = std::move(ahead->fit);
+            misses = std::move(ahead->misses);
         } else if (!r) {
             r = fit_faces(c, faces, kinds, std::nullopt, &misses, ruled_sag);
         }
@@ -1138,9 +1147,9 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
             }
         }
         if (!r && !misses.empty()) {
-            if (known && ahead->second.without_strays_tried) {
-                r = ahead->second.without_strays;
-                strays = ahead->second.strays;
+            if (known && ahead->without_strays_tried) {
+                r = std::move(ahead->without_strays);
+                strays = std::move(ahead->strays);
             } else {
                 r = fit_without_strays(c, faces, misses, strays);
             }
