@@ -970,6 +970,12 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
         }
         return kinds;
     };
+    // Whether the larger of a pair (the first of two alike in size) dominates a small neighbour
+    // with at least kMaxGrowthRefit facets: a pair decided on its surface, not refitted (below).
+    const auto large_and_dominant = [&](std::uint32_t big, std::uint32_t small) {
+        return drafts[big].faces.size() >= kDominantRatio * drafts[small].faces.size() &&
+               drafts[big].faces.size() >= kMaxGrowthRefit;
+    };
     const auto union_sag = [&](std::uint32_t a, std::uint32_t b) {
         return std::min(drafts[a].faces.size(), drafts[b].faces.size()) <= kLooseFacets
                    ? RuledSag::kTwice
@@ -979,8 +985,7 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
     // refit depends on nothing but the two regions as they are (their versions). So the next
     // pairs of the queue are fitted on all cores ahead of their turn (kFitAhead at a time), and
     // a pair takes its result when it comes up with both versions unchanged: the same results
-    // in the same order as fitting each in turn. (The freeform die at 159k facets refits
-    // 4.1M facets in 1836 unions, 324 taken; docs/benchmarks.md.)
+    // in the same order as fitting each in turn (docs/benchmarks.md: the freeform die).
     struct Ahead {
         std::optional<FitResult> fit;
         std::vector<Surface> misses;
@@ -989,6 +994,9 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
         std::vector<std::uint32_t> strays;
     };
     using Key = std::tuple<std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>;
+    const auto key_of = [](const Item& it) {
+        return Key{std::get<1>(it), std::get<2>(it), std::get<3>(it), std::get<4>(it)};
+    };
     std::map<Key, Ahead> fitted_ahead;
     const auto fit_ahead = [&] {
         std::vector<Item> next;
@@ -1009,23 +1017,17 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
         }
         // Fitted in batches: once the next pair's fit is missing, the missing ones of the next
         // kFitAhead together (one at a time would leave a core idle).
-        const bool batch =
-            !next.empty() &&
-            !fitted_ahead.count({std::get<1>(next.front()), std::get<2>(next.front()),
-                                 std::get<3>(next.front()), std::get<4>(next.front())});
+        const bool batch = !next.empty() && !fitted_ahead.count(key_of(next.front()));
         std::vector<Key> todo;
         for (const Item& it : next) {
             pq.push(it);
             if (!batch) continue;
-            const auto [cost, a, b, va, vb, exact] = it;
-            const Key key{a, b, va, vb};
+            const Key key = key_of(it);
             if (fitted_ahead.count(key)) continue;
             // The pairs the large-region rule decides without a refit, in turn.
-            const std::uint32_t big = drafts[a].faces.size() >= drafts[b].faces.size() ? a : b;
-            const std::uint32_t small = big == a ? b : a;
-            if (drafts[big].faces.size() >= kDominantRatio * drafts[small].faces.size() &&
-                drafts[big].faces.size() >= kMaxGrowthRefit)
-                continue;
+            const auto [cost, a, b, va, vb, exact] = it;
+            const bool a_larger = drafts[a].faces.size() >= drafts[b].faces.size();
+            if (a_larger ? large_and_dominant(a, b) : large_and_dominant(b, a)) continue;
             todo.push_back(key);
         }
         if (todo.size() < 2) return;  // one: fitted in turn, as before
@@ -1084,8 +1086,7 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
         // regions: a drafted wall's narrow strips of NIST CTC 02 fit cones that their
         // neighbour strips move by more than 10 tolerances, 640 -> 708 faces.)
         const std::uint32_t big = na >= nb ? a : b, small = big == a ? b : a;
-        if (!fragments && drafts[big].faces.size() >= kDominantRatio * drafts[small].faces.size() &&
-            drafts[big].faces.size() >= kMaxGrowthRefit) {
+        if (!fragments && large_and_dominant(big, small)) {
             const Surface& sb = drafts[big].surface;
             double far_area = 0, small_area = 0;
             bool on = true;
