@@ -1,11 +1,17 @@
 #include "brep/check.h"
 
+#include <tbb/parallel_for.h>
+
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepCheck.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepCheck_Result.hxx>
 #include <BRepGProp.hxx>
+#include <BRepGProp_Domain.hxx>
+#include <BRepGProp_Face.hxx>
+#include <BRepGProp_Vinert.hxx>
 #include <BRepTools.hxx>
+#include <BRep_Tool.hxx>
 #include <GProp_GProps.hxx>
 #include <ShapeUpgrade_ShapeDivideAngle.hxx>
 #include <TopExp.hxx>
@@ -15,6 +21,7 @@
 #include <cctype>
 #include <numbers>
 #include <sstream>
+#include <vector>
 
 namespace ncrev::brep_detail {
 
@@ -94,9 +101,47 @@ double solid_volume(const TopoDS_Shape& shape) {
         if (divide.Perform()) measured = divide.Result();
         break;
     }
-    GProp_GProps props;
-    BRepGProp::VolumeProperties(measured, props, kVolumeRelativeError);
-    return props.Mass();
+    // Each face's share on its own, in parallel, then summed in order: what
+    // BRepGProp::VolumeProperties does one face after the other (one core took 1.3 s for the 705
+    // faces of OCCT's TR12J mesh). The same integrals about the same point, the mean of the
+    // shape's vertices as its explorer lists them, added in the same order: the same bits. A
+    // shape it would measure otherwise (located; a face without a surface or without a wire,
+    // for which it reuses the previous face's domain) is measured its way, whole.
+    const auto whole = [&] {
+        GProp_GProps props;
+        BRepGProp::VolumeProperties(measured, props, kVolumeRelativeError);
+        return props.Mass();
+    };
+    if (!measured.Location().IsIdentity()) return whole();
+    gp_XYZ sum(0, 0, 0);
+    int vertices = 0;
+    for (TopExp_Explorer x(measured, TopAbs_VERTEX); x.More(); x.Next(), ++vertices)
+        sum += BRep_Tool::Pnt(TopoDS::Vertex(x.Current())).XYZ();
+    if (vertices == 0) return whole();
+    sum /= vertices;
+    const gp_Pnt center(sum);
+    std::vector<TopoDS_Face> faces;
+    for (TopExp_Explorer x(measured, TopAbs_FACE); x.More(); x.Next()) {
+        const TopoDS_Face& f = TopoDS::Face(x.Current());
+        if (f.Orientation() != TopAbs_FORWARD && f.Orientation() != TopAbs_REVERSED) continue;
+        TopLoc_Location loc;
+        if (BRep_Tool::Surface(f, loc).IsNull() || f.NbChildren() == 0) return whole();
+        faces.push_back(f);
+    }
+    std::vector<double> mass(faces.size(), 0.0);
+    tbb::parallel_for(std::size_t{0}, faces.size(), [&](std::size_t i) {
+        BRepGProp_Face face;
+        face.Load(faces[i]);
+        BRepGProp_Domain domain;
+        domain.Init(faces[i]);
+        BRepGProp_Vinert integral;
+        integral.SetLocation(center);
+        integral.Perform(face, domain, kVolumeRelativeError);
+        mass[i] = integral.Mass();
+    });
+    double total = 0;
+    for (const double m : mass) total += m;
+    return total;
 }
 
 }  // namespace ncrev::brep_detail
