@@ -13,12 +13,15 @@
 #include <BRepTools.hxx>
 #include <BRep_Tool.hxx>
 #include <GProp_GProps.hxx>
+#include <Precision.hxx>
 #include <ShapeUpgrade_ShapeDivideAngle.hxx>
 #include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
+#include <atomic>
 #include <cctype>
+#include <cstddef>
 #include <numbers>
 #include <sstream>
 #include <vector>
@@ -101,34 +104,36 @@ double solid_volume(const TopoDS_Shape& shape) {
         if (divide.Perform()) measured = divide.Result();
         break;
     }
-    // Each face's share on its own, in parallel, then summed in order: what
-    // BRepGProp::VolumeProperties does one face after the other (one core took 1.3 s for the 705
-    // faces of OCCT's TR12J mesh). The same integrals about the same point, the mean of the
-    // shape's vertices as its explorer lists them, added in the same order: the same bits. A
-    // shape it would measure otherwise (located; a face without a surface or without a wire,
-    // for which it reuses the previous face's domain) is measured its way, whole.
-    const auto whole = [&] {
-        GProp_GProps props;
-        BRepGProp::VolumeProperties(measured, props, kVolumeRelativeError);
-        return props.Mass();
-    };
-    if (!measured.Location().IsIdentity()) return whole();
+    if (const std::optional<double> v = volume_by_faces(measured, kVolumeRelativeError)) return *v;
+    GProp_GProps props;
+    BRepGProp::VolumeProperties(measured, props, kVolumeRelativeError);
+    return props.Mass();
+}
+
+std::optional<double> volume_by_faces(const TopoDS_Shape& shape, double relative_error) {
+    // What BRepGProp::VolumeProperties does one face after the other (BRepGProp.cxx): the
+    // faces' integrals about the mean of the shape's vertices as its explorer lists them,
+    // added in the explorer's order. Not for a face it measures otherwise: one without a
+    // surface (skipped, or measured from its triangulation), one without a wire (given the
+    // previous face's domain), one with an edge without a curve on it (its integral fails and
+    // BRepGProp adds the previous face's again).
     gp_XYZ sum(0, 0, 0);
     int vertices = 0;
-    for (TopExp_Explorer x(measured, TopAbs_VERTEX); x.More(); x.Next(), ++vertices)
+    for (TopExp_Explorer x(shape, TopAbs_VERTEX); x.More(); x.Next(), ++vertices)
         sum += BRep_Tool::Pnt(TopoDS::Vertex(x.Current())).XYZ();
-    if (vertices == 0) return whole();
+    if (vertices == 0) return std::nullopt;
     sum /= vertices;
     const gp_Pnt center(sum);
     std::vector<TopoDS_Face> faces;
-    for (TopExp_Explorer x(measured, TopAbs_FACE); x.More(); x.Next()) {
+    for (TopExp_Explorer x(shape, TopAbs_FACE); x.More(); x.Next()) {
         const TopoDS_Face& f = TopoDS::Face(x.Current());
         if (f.Orientation() != TopAbs_FORWARD && f.Orientation() != TopAbs_REVERSED) continue;
         TopLoc_Location loc;
-        if (BRep_Tool::Surface(f, loc).IsNull() || f.NbChildren() == 0) return whole();
+        if (BRep_Tool::Surface(f, loc).IsNull() || f.NbChildren() == 0) return std::nullopt;
         faces.push_back(f);
     }
     std::vector<double> mass(faces.size(), 0.0);
+    std::atomic<bool> failed = false;
     tbb::parallel_for(std::size_t{0}, faces.size(), [&](std::size_t i) {
         BRepGProp_Face face;
         face.Load(faces[i]);
@@ -136,9 +141,10 @@ double solid_volume(const TopoDS_Shape& shape) {
         domain.Init(faces[i]);
         BRepGProp_Vinert integral;
         integral.SetLocation(center);
-        integral.Perform(face, domain, kVolumeRelativeError);
+        if (Precision::IsInfinite(integral.Perform(face, domain, relative_error))) failed = true;
         mass[i] = integral.Mass();
     });
+    if (failed) return std::nullopt;
     double total = 0;
     for (const double m : mass) total += m;
     return total;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <TopoDS_Shape.hxx>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,13 @@ std::string check_failure(const TopoDS_Shape& shape, std::vector<TopoDS_Shape>* 
 constexpr double kVolumeRelativeError = 1e-7;
 
 /// The volume of `shape` (a solid, or a shape holding one) within kVolumeRelativeError; a face
-/// that goes round its periodic surface more than once is measured in pieces of one turn.
+/// that goes round its periodic surface more than once is measured in pieces of one turn. The
+/// faces are integrated on all cores (volume_by_faces()), BRepGProp's way where that cannot.
 double solid_volume(const TopoDS_Shape& shape);
+
+/// BRepGProp::VolumeProperties(shape, props, relative_error)'s volume to the bit, its faces
+/// integrated on all cores and summed in its order; nothing for a shape it measures otherwise
+/// (no vertex; a face without a surface or a wire, or with an edge without its curve on it).
+std::optional<double> volume_by_faces(const TopoDS_Shape& shape, double relative_error);
 
 }  // namespace ncrev::brep_detail
