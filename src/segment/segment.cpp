@@ -971,7 +971,8 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
         return kinds;
     };
     // Whether the larger of a pair (the first of two alike in size) dominates a small neighbour
-    // with at least kMaxGrowthRefit facets: a pair decided on its surface, not refitted (below).
+    // with at least kMaxGrowthRefit facets: a pair mostly decided on its surface, refitted only
+    // when the neighbour lies neither far from it nor on it (below).
     const auto large_and_dominant = [&](std::uint32_t big, std::uint32_t small) {
         return drafts[big].faces.size() >= kDominantRatio * drafts[small].faces.size() &&
                drafts[big].faces.size() >= kMaxGrowthRefit;
@@ -1024,7 +1025,8 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
             if (!batch) continue;
             const Key key = key_of(it);
             if (fitted_ahead.count(key)) continue;
-            // The pairs the large-region rule decides without a refit, in turn.
+            // Not a pair with a large dominant region: mostly decided without its refit (an
+            // expensive one), which then comes in turn.
             const auto [cost, a, b, va, vb, exact] = it;
             const bool a_larger = drafts[a].faces.size() >= drafts[b].faces.size();
             if (a_larger ? large_and_dominant(a, b) : large_and_dominant(b, a)) continue;
