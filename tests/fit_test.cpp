@@ -974,5 +974,54 @@ TEST(Fit, ATurnedDomeIsTheInnerPartOfASpindleTorus) {
     EXPECT_FALSE(g.ok) << "R " << g.surface.radius << " r " << g.surface.minor_radius;
 }
 
+// A caller that accepts fits within a tolerance t may pass refuse_rms (a few t): a fit of many
+// points is first made on a strided sample of them and refused when that fit is off by more
+// (docs/fitting.md; growing a 950k-facet part's tori). A patch of the kind is fitted as it is
+// without, to the bit; a union with another surface's points is refused, and its whole fit
+// would not have held it within t either; a fit of fewer points is never sampled.
+TEST(Fit, ManyPointsOffTheirSampleFitAreRefusedWithoutTheWholeFit) {
+    test::Rng rng(21);
+    const auto same = [](const FitResult& a, const FitResult& b) {
+        return a.ok == b.ok && a.rms == b.rms && a.max == b.max && a.iterations == b.iterations &&
+               a.surface.point == b.surface.point && a.surface.axis == b.surface.axis &&
+               a.surface.radius == b.surface.radius &&
+               a.surface.minor_radius == b.surface.minor_radius &&
+               a.surface.angle == b.surface.angle;
+    };
+    for (const Patch& p : target_patches(rng, 2 * kSampledFitPoints)) {
+        if (p.truth.kind == FitKind::kPlane) continue;
+        FitInput in{p.points, p.normals, {}};
+        const FitResult whole = fit(p.truth.kind, in);
+        in.refuse_rms = 1e-4 * p.size;
+        const FitResult sampled = fit(p.truth.kind, in);
+        ASSERT_TRUE(sampled.ok) << p.name << ": " << sampled.failure;
+        EXPECT_TRUE(same(sampled, whole)) << p.name;
+    }
+    // A torus band beside a cylinder's patch (placed elsewhere): no torus holds both.
+    const Patch band = torus_patch(rng, 30, 6, 90, 90, 2 * kSampledFitPoints);
+    const Patch other = cylinder_patch(rng, 12, 90, 20, kSampledFitPoints / 4);
+    std::vector<Vec3> points = band.points, normals = band.normals;
+    points.insert(points.end(), other.points.begin(), other.points.end());
+    normals.insert(normals.end(), other.normals.begin(), other.normals.end());
+    const double t = 1e-4 * band.size;
+    FitInput in{points, normals, {}};
+    const FitResult whole = fit(FitKind::kTorus, in);
+    EXPECT_FALSE(whole.ok && whole.max <= t);
+    in.refuse_rms = 3 * t;
+    const FitResult refused = fit(FitKind::kTorus, in);
+    EXPECT_FALSE(refused.ok);
+    EXPECT_NE(refused.failure.find("sample"), std::string::npos) << refused.failure;
+    // Fewer points than kSampledFitPoints: fitted whole, as without refuse_rms.
+    const std::size_t few = kSampledFitPoints / 2;
+    std::vector<Vec3> few_points(band.points.begin(), band.points.begin() + few),
+        few_normals(band.normals.begin(), band.normals.begin() + few);
+    few_points.insert(few_points.end(), other.points.begin(), other.points.end());
+    few_normals.insert(few_normals.end(), other.normals.begin(), other.normals.end());
+    FitInput small{few_points, few_normals, {}};
+    const FitResult small_whole = fit(FitKind::kTorus, small);
+    small.refuse_rms = 3 * t;
+    EXPECT_TRUE(same(fit(FitKind::kTorus, small), small_whole));
+}
+
 }  // namespace
 }  // namespace ncrev

@@ -142,7 +142,17 @@ struct FitInput {
     int max_profile_poles = 0;
     /// When positive, a net over the mean plane has at most this many poles (likewise).
     int max_net_poles = 0;
+    /// When positive, a sphere, cylinder, cone or torus fit of many points (kSampledFitPoints
+    /// or more) is first made on a strided sample of them, and refused (ok false) when that
+    /// fit's weighted RMS exceeds this; otherwise the fit is the one made without it. A surface
+    /// holding every point within t holds the sample with an RMS within t, and the sample's
+    /// least-squares fit does no worse: a caller that accepts max <= t passes a few t (the
+    /// margin for a fit that stops short of the least squares) and loses no fit it accepts.
+    double refuse_rms = 0;
 };
+
+/// The fewest points a fit samples first (FitInput::refuse_rms).
+inline constexpr std::size_t kSampledFitPoints = 16384;
 
 /// The outcome of one fit: `ok` false when the points do not determine the surface (too few,
 /// collinear, a degenerate start, no convergence), with the reason in `failure`. Residuals are

@@ -102,6 +102,10 @@ constexpr std::size_t kDominantRatio = 4;
 constexpr std::size_t kMaxGrowthRefit = 1u << 14;
 /// From this many facets a growing region's kind is settled (see settled()).
 constexpr std::size_t kSettledFacets = 4096;
+/// Large unions are refused on a sample's fit off by an RMS of more than this many
+/// tolerances (FitInput::refuse_rms; see fit_faces()): the margin covers a fit that stops short
+/// of the least squares (a local minimum, the iteration cap).
+constexpr double kSampleRefuseTolerances = 3;
 /// See firm_plane().
 constexpr std::size_t kFirmPlaneFacets = 8;
 constexpr double kFirmPlaneShare = 0.01;
@@ -494,6 +498,11 @@ std::optional<FitResult> fit_faces(Context& c, std::span<const std::uint32_t> fa
         if (!first || kind != *first) order[n++] = kind;
     FitInput in = ps.input();
     in.accept = c.tol;
+    // A large union that a strided sample of its points refuses is not fitted whole
+    // (FitInput::refuse_rms): growing a 213k-facet torus stalls on unions with the cone beside
+    // it, RMS 30 tolerances, fitted kind by kind to the iteration cap over 100k points. Not for
+    // callers that take the refused surfaces (`misses`) as starts: theirs are the whole fit's.
+    if (!misses) in.refuse_rms = kSampleRefuseTolerances * c.tol;
     for (std::size_t i = 0; i < n; ++i) {
         const FitKind kind = order[i];
         if ((kinds & fit_kind_bit(kind)) == 0) continue;
