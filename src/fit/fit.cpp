@@ -1047,8 +1047,7 @@ FitResult fit_cone(const FitInput& in) {
 constexpr std::size_t kSpineSamples = 512;
 /// The sample a fit of many points is refused on (FitInput::refuse_rms): every n-th point,
 /// this many or more. Enough to fix a torus's seven parameters far better than a refusal
-/// needs, and a fiftieth of the cost on the 100k-point unions that growing a 950k-facet part's
-/// tori tries.
+/// needs; a union of 100k points costs a fiftieth of its whole fit to refuse.
 constexpr std::size_t kRefuseSamplePoints = 2048;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 /// The tube radii spine_start() tries: +-4 x the points' reach x 2^(-k/2) for k < kSpineSteps,

@@ -500,7 +500,7 @@ std::optional<FitResult> fit_faces(Context& c, std::span<const std::uint32_t> fa
     in.accept = c.tol;
     // A large union that a strided sample of its points refuses is not fitted whole
     // (FitInput::refuse_rms): growing a 213k-facet torus stalls on unions with the cone beside
-    // it, RMS 30 tolerances, fitted kind by kind to the iteration cap over 100k points. Not for
+    // it, far off every kind, which were fitted kind by kind over all their points. Not for
     // callers that take the refused surfaces (`misses`) as starts: theirs are the whole fit's.
     if (!misses) in.refuse_rms = kSampleRefuseTolerances * c.tol;
     for (std::size_t i = 0; i < n; ++i) {
