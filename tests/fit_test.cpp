@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -1021,6 +1022,40 @@ TEST(Fit, ManyPointsOffTheirSampleFitAreRefusedWithoutTheWholeFit) {
     const FitResult small_whole = fit(FitKind::kTorus, small);
     small.refuse_rms = 3 * t;
     EXPECT_TRUE(same(fit(FitKind::kTorus, small), small_whole));
+}
+
+// refit(): from a surface near the fit (the fit moved by a thousandth of the patch's size, its
+// radii by a thousandth of themselves, as a region's surface before its border moved) to the
+// same least-squares minimum as fit(); a plane is fitted as by fit(); a start that is no finite
+// surface fails cleanly.
+TEST(Fit, RefitFromANearbySurfaceReachesTheFit) {
+    test::Rng rng(23);
+    for (Patch p : target_patches(rng, 4000)) {
+        add_noise(p, 0.001 * p.size, rng);
+        const FitInput in{p.points, p.normals, {}};
+        const FitResult whole = fit(p.truth.kind, in);
+        ASSERT_TRUE(whole.ok) << p.name << ": " << whole.failure;
+        Surface start = whole.surface;
+        start.point += Vec3{0.6, -0.5, 0.6} * (1e-3 * p.size);
+        start.radius *= 1.001;
+        start.minor_radius *= 1.001;
+        const FitResult again = refit(start, in);
+        ASSERT_TRUE(again.ok) << p.name << ": " << again.failure;
+        EXPECT_EQ(again.surface.kind, whole.surface.kind);
+        EXPECT_NEAR(again.rms, whole.rms, 1e-6 * whole.rms) << p.name;
+        const ParamErrors e = compare(again.surface, p);
+        EXPECT_LE(e.radius, 0.005) << p.name;
+        EXPECT_LE(e.minor, 0.005) << p.name;
+        if (p.truth.kind == FitKind::kPlane) {
+            EXPECT_EQ(again.rms, whole.rms);
+        }
+    }
+    const Patch p = torus_patch(rng, 30, 6, 90, 90);
+    Surface bad = p.truth;
+    bad.radius = std::numeric_limits<double>::quiet_NaN();
+    const FitResult r = refit(bad, FitInput{p.points, p.normals, {}});
+    EXPECT_FALSE(r.ok);
+    EXPECT_FALSE(r.failure.empty());
 }
 
 }  // namespace

@@ -175,6 +175,13 @@ FitResult residuals(const Surface& surface, const FitInput& input);
 /// to within 1e-4 of the points' extent (see fit_bspline()). Never throws.
 FitResult fit(FitKind kind, const FitInput& input);
 
+/// A sphere, cylinder, cone or torus refined on the points from `start` (Levenberg-Marquardt,
+/// none of fit()'s starts): for a surface fitted to nearly the same points, a region that gained
+/// or lost a few facets on its border, where it converges in a step or two. It settles in the
+/// least-squares minimum nearest the start, which fit() may leave for a better one. The same
+/// checks and result as fit(); other kinds are fitted by fit(). Never throws.
+FitResult refit(const Surface& start, const FitInput& input);
+
 /// The fewest points fit_bspline() and fit_helical() take: a bicubic net's 16 poles.
 inline constexpr std::size_t kMinBSplinePoints = 16;
 

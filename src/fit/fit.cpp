@@ -988,6 +988,8 @@ FitResult fit_cylinder(const FitInput& in) {
     return better_fit(other, res, in) ? other : res;
 }
 
+FitResult refine_cone(ConeModel& m, const FitInput& in);
+
 /// The cone about the axis through c along unit d: its generator line rho = r + t h by
 /// weighted least squares in the meridian plane, then refined.
 FitResult cone_about(const FitInput& in, Vec3 c, Vec3 d) {
@@ -1009,6 +1011,11 @@ FitResult cone_about(const FitInput& in, Vec3 c, Vec3 d) {
         t = -t;
     }
     ConeModel m = ConeModel::make(Axis::make(c, d), r, std::atan(t));
+    return refine_cone(m, in);
+}
+
+/// The cone refined from m, with its half-angle and radius checked.
+FitResult refine_cone(ConeModel& m, const FitInput& in) {
     const int it = refine(m, in);
     if (m.alpha < 0) {  // crossed through a cylinder: turn the axis round
         m = ConeModel::make(Axis::make(m.a.c, -m.a.d), m.r, -m.alpha);
@@ -2673,7 +2680,10 @@ FitResult fit_bspline(const FitInput& in, double tolerance) {
     return fit_bspline_impl(in, tolerance);
 }
 
-FitResult fit(FitKind kind, const FitInput& in) {
+namespace {
+
+/// What fit() and refit() ask of every input: a failure, or nothing.
+std::optional<FitResult> invalid_input(FitKind kind, const FitInput& in) {
     const std::size_t n = in.points.size();
     if (!in.weights.empty() && in.weights.size() != n) {
         return failed(kind, "weights and points differ in number");
@@ -2688,6 +2698,50 @@ FitResult fit(FitKind kind, const FitInput& in) {
             return failed(kind, "a point or weight is not a finite number");
         }
     }
+    return std::nullopt;
+}
+
+}  // namespace
+
+FitResult refit(const Surface& start, const FitInput& in) {
+    const FitKind kind = start.kind;
+    if (kind != FitKind::kSphere && kind != FitKind::kCylinder && kind != FitKind::kCone &&
+        kind != FitKind::kTorus) {
+        return fit(kind, in);
+    }
+    if (auto bad = invalid_input(kind, in)) return *bad;
+    if (!finite(start.point) || !finite(start.axis) || !std::isfinite(start.radius) ||
+        !std::isfinite(start.angle) || !std::isfinite(start.minor_radius) ||
+        (kind != FitKind::kSphere && !(norm(start.axis) > 0))) {
+        return failed(kind, "the start is not a finite surface");
+    }
+    switch (kind) {
+        case FitKind::kSphere: {
+            SphereModel m{start.point, start.radius};
+            const int it = refine(m, in);
+            if (m.r < 0) m.r = -m.r;
+            return finish(m, it, in);
+        }
+        case FitKind::kCylinder: {
+            CylinderModel m{Axis::make(start.point, start.axis), start.radius};
+            const int it = refine(m, in);
+            return finish(m, it, in);
+        }
+        case FitKind::kCone: {
+            ConeModel m =
+                ConeModel::make(Axis::make(start.point, start.axis), start.radius, start.angle);
+            return refine_cone(m, in);
+        }
+        default: {
+            TorusModel m{Axis::make(start.point, start.axis), start.radius, start.minor_radius};
+            return refine_torus(m, in);
+        }
+    }
+}
+
+FitResult fit(FitKind kind, const FitInput& in) {
+    const std::size_t n = in.points.size();
+    if (auto bad = invalid_input(kind, in)) return *bad;
     // Every kind needs points that span a plane at least.
     {
         const Vec3 c = centroid(in);

@@ -1877,7 +1877,12 @@ std::optional<Surface> refit_same_kind(Context& c, const Draft& d) {
     c.gatherers.local().gather(c.m, c.fd, d.faces, ps);
     const FitInput in = ps.input();
     if (in.points.size() < kMinVertices[static_cast<int>(d.surface.kind)]) return std::nullopt;
-    FitResult r = fit(d.surface.kind, in);
+    // A settled region (settled()) from its surface: a refinement pass moves facets on the
+    // borders only, and fitting the fillet block's corner tori of 200k facets (at 950k) afresh
+    // each pass cost most of refining. A smaller one afresh: a few facets more or less can move
+    // its least squares to another minimum, which a refinement from the old one would miss
+    // (the link rods' free-form pieces: a face and a fallback more when all were refitted so).
+    const FitResult r = settled(d) ? refit(d.surface, in) : fit(d.surface.kind, in);
     if (!r.ok || !(r.max <= c.tol) || !chords_agree(c, r.surface, d.faces)) return std::nullopt;
     if (!(r.rms <= kExactShare * c.tol)) return std::nullopt;
     return r.surface;
