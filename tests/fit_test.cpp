@@ -991,6 +991,18 @@ TEST(Fit, ManyPointsOffTheirSampleFitAreRefusedWithoutTheWholeFit) {
     };
     for (const Patch& p : target_patches(rng, 2 * kSampledFitPoints)) {
         if (p.truth.kind == FitKind::kPlane) continue;
+        // Spheres also without normals (they need none) and with uneven weights.
+        std::vector<double> weights(p.points.size());
+        for (std::size_t i = 0; i < weights.size(); ++i) weights[i] = 0.5 + (i % 7) * 0.25;
+        if (p.truth.kind == FitKind::kSphere) {
+            for (const FitInput& bare :
+                 {FitInput{p.points, {}, {}}, FitInput{p.points, {}, weights}}) {
+                FitInput with = bare;
+                with.refuse_rms = 1e-4 * p.size;
+                EXPECT_TRUE(same(fit(FitKind::kSphere, with), fit(FitKind::kSphere, bare)))
+                    << p.name;
+            }
+        }
         FitInput in{p.points, p.normals, {}};
         const FitResult whole = fit(p.truth.kind, in);
         in.refuse_rms = 1e-4 * p.size;
@@ -1037,8 +1049,10 @@ TEST(Fit, RefitFromANearbySurfaceReachesTheFit) {
         ASSERT_TRUE(whole.ok) << p.name << ": " << whole.failure;
         Surface start = whole.surface;
         start.point += Vec3{0.6, -0.5, 0.6} * (1e-3 * p.size);
+        start.axis = normalized(start.axis + Vec3{0.01, 0.0, -0.01});  // about 0.8 degrees
         start.radius *= 1.001;
         start.minor_radius *= 1.001;
+        start.angle *= 1.001;
         const FitResult again = refit(start, in);
         ASSERT_TRUE(again.ok) << p.name << ": " << again.failure;
         EXPECT_EQ(again.surface.kind, whole.surface.kind);
@@ -1048,6 +1062,13 @@ TEST(Fit, RefitFromANearbySurfaceReachesTheFit) {
         EXPECT_LE(e.minor, 0.005) << p.name;
         if (p.truth.kind == FitKind::kPlane) {
             EXPECT_EQ(again.rms, whole.rms);
+        } else if (p.truth.kind != FitKind::kSphere) {
+            // No start of fit()'s: none from the normals, which an axis needs there.
+            const FitInput bare{p.points, {}, {}};
+            EXPECT_FALSE(fit(p.truth.kind, bare).ok) << p.name;
+            const FitResult from = refit(start, bare);
+            ASSERT_TRUE(from.ok) << p.name << ": " << from.failure;
+            EXPECT_NEAR(from.rms, whole.rms, 1e-6 * whole.rms) << p.name;
         }
     }
     const Patch p = torus_patch(rng, 30, 6, 90, 90);

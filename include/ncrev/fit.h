@@ -144,14 +144,17 @@ struct FitInput {
     int max_net_poles = 0;
     /// When positive, a sphere, cylinder, cone or torus fit of many points (kSampledFitPoints
     /// or more) is first made on a strided sample of them, and refused (ok false) when that
-    /// fit's weighted RMS exceeds this; otherwise the fit is the one made without it. A surface
-    /// holding every point within t holds the sample with an RMS within t, and the sample's
-    /// least-squares fit does no worse: a caller that accepts max <= t passes a few t (the
-    /// margin for a fit that stops short of the least squares) and loses no fit it accepts.
+    /// fit's weighted RMS exceeds this; otherwise the fit is the one made without it, to the
+    /// bit. A surface holding every point within t holds the sample with an RMS within t, and
+    /// the sample's least-squares minimum does no worse: a caller that keeps fits with max <= t
+    /// passes a few t, the margin for a fit that stops short of that minimum (a local one, the
+    /// iteration cap), and should lose none it keeps (docs/fitting.md: segmentation's study
+    /// unchanged with 3 t).
     double refuse_rms = 0;
 };
 
-/// The fewest points a fit samples first (FitInput::refuse_rms).
+/// The fewest points a fit samples first (FitInput::refuse_rms): eight times the sample, so
+/// that a fit that is not refused costs at most an eighth more.
 inline constexpr std::size_t kSampledFitPoints = 16384;
 
 /// The outcome of one fit: `ok` false when the points do not determine the surface (too few,
@@ -177,9 +180,11 @@ FitResult fit(FitKind kind, const FitInput& input);
 
 /// A sphere, cylinder, cone or torus refined on the points from `start` (Levenberg-Marquardt,
 /// none of fit()'s starts): for a surface fitted to nearly the same points, a region that gained
-/// or lost a few facets on its border, where it converges in a step or two. It settles in the
-/// least-squares minimum nearest the start, which fit() may leave for a better one. The same
-/// checks and result as fit(); other kinds are fitted by fit(). Never throws.
+/// or lost a few facets on its border, where it converges in a few steps. It settles in the
+/// least-squares minimum nearest the start, which fit() may leave for a better one. fit()'s
+/// input checks and its checks of the result (a radius running away, a cone's half-angle, a
+/// torus's radii); not refuse_rms, accept or fit()'s choice between starts. Other kinds are
+/// fitted by fit(). Never throws.
 FitResult refit(const Surface& start, const FitInput& input);
 
 /// The fewest points fit_bspline() and fit_helical() take: a bicubic net's 16 poles.

@@ -1054,7 +1054,8 @@ FitResult fit_cone(const FitInput& in) {
 constexpr std::size_t kSpineSamples = 512;
 /// The sample a fit of many points is refused on (FitInput::refuse_rms): every n-th point,
 /// this many or more. Enough to fix a torus's seven parameters far better than a refusal
-/// needs; a union of 100k points costs a fiftieth of its whole fit to refuse.
+/// needs; each of its iterations goes over 2048 / n of the points (kSampledFitPoints keeps
+/// that at most an eighth, the cost added to a fit that is not refused).
 constexpr std::size_t kRefuseSamplePoints = 2048;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 /// The tube radii spine_start() tries: +-4 x the points' reach x 2^(-k/2) for k < kSpineSteps,
@@ -1115,6 +1116,7 @@ struct Strided {
     std::vector<Vec3> points, normals;
     std::vector<double> weights;
     Strided(const FitInput& in, std::size_t step) {
+        step = std::max<std::size_t>(step, 1);  // (callers pass 1 or more)
         for (std::size_t i = 0; i < in.points.size(); i += step) {
             points.push_back(in.points[i]);
             if (!in.normals.empty()) normals.push_back(in.normals[i]);
@@ -2682,7 +2684,8 @@ FitResult fit_bspline(const FitInput& in, double tolerance) {
 
 namespace {
 
-/// What fit() and refit() ask of every input: a failure, or nothing.
+/// What fit() and refit() ask of every input (matching sizes, finite points, non-negative
+/// weights, points spanning a plane): a failure, or nothing.
 std::optional<FitResult> invalid_input(FitKind kind, const FitInput& in) {
     const std::size_t n = in.points.size();
     if (!in.weights.empty() && in.weights.size() != n) {
@@ -2698,6 +2701,16 @@ std::optional<FitResult> invalid_input(FitKind kind, const FitInput& in) {
             return failed(kind, "a point or weight is not a finite number");
         }
     }
+    // Every kind needs points that span a plane at least.
+    const Vec3 c = centroid(in);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 q = in.points[i] - c;
+        const Eigen::Vector3d e(q.x, q.y, q.z);
+        cov += weight(in, i) * e * e.transpose();
+    }
+    const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues();
+    if (!(ev(1) > kCollinear * ev(2))) return failed(kind, "the points are collinear or coincide");
     return std::nullopt;
 }
 
@@ -2742,20 +2755,6 @@ FitResult refit(const Surface& start, const FitInput& in) {
 FitResult fit(FitKind kind, const FitInput& in) {
     const std::size_t n = in.points.size();
     if (auto bad = invalid_input(kind, in)) return *bad;
-    // Every kind needs points that span a plane at least.
-    {
-        const Vec3 c = centroid(in);
-        Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-        for (std::size_t i = 0; i < n; ++i) {
-            const Vec3 q = in.points[i] - c;
-            const Eigen::Vector3d e(q.x, q.y, q.z);
-            cov += weight(in, i) * e * e.transpose();
-        }
-        const Eigen::Vector3d ev =
-            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues();
-        if (!(ev(1) > kCollinear * ev(2)))
-            return failed(kind, "the points are collinear or coincide");
-    }
     // The sample: every step-th point, kRefuseSamplePoints or more (FitInput::refuse_rms).
     const bool sampled = kind == FitKind::kSphere || kind == FitKind::kCylinder ||
                          kind == FitKind::kCone || kind == FitKind::kTorus;
@@ -2765,8 +2764,9 @@ FitResult fit(FitKind kind, const FitInput& in) {
         sample.refuse_rms = 0;
         const FitResult look = fit(kind, sample);
         if (look.ok && look.rms > in.refuse_rms) {
-            return failed(
-                kind, "a sample of the points is off its fit by RMS " + std::to_string(look.rms));
+            char rms[32];
+            std::snprintf(rms, sizeof rms, "%.6g", look.rms);
+            return failed(kind, std::string("a sample of the points is off its fit by RMS ") + rms);
         }
     }
     switch (kind) {
@@ -2836,7 +2836,7 @@ constexpr double kRadiusSteps[] = {1.0, 0.5, 0.1, 0.05, 0.01};
 constexpr double kAngleStepsDegrees[] = {5.0, 1.0, 0.5};
 
 template <class Model>
-FitResult refit(Model m, unsigned frozen, const FitInput& in) {
+FitResult refine_held(Model m, unsigned frozen, const FitInput& in) {
     const int it = refine(m, in, frozen);
     return finish(m, it, in);
 }
@@ -2851,15 +2851,15 @@ FitResult refit_surface(const Surface& s, unsigned frozen, const FitInput& in) {
             return residuals(p, in);
         }
         case FitKind::kSphere:
-            return refit(SphereModel{s.point, s.radius}, frozen, in);
+            return refine_held(SphereModel{s.point, s.radius}, frozen, in);
         case FitKind::kCylinder:
-            return refit(CylinderModel{Axis::make(s.point, s.axis), s.radius}, frozen, in);
+            return refine_held(CylinderModel{Axis::make(s.point, s.axis), s.radius}, frozen, in);
         case FitKind::kCone:
-            return refit(ConeModel::make(Axis::make(s.point, s.axis), s.radius, s.angle), frozen,
-                         in);
+            return refine_held(ConeModel::make(Axis::make(s.point, s.axis), s.radius, s.angle),
+                               frozen, in);
         case FitKind::kTorus:
-            return refit(TorusModel{Axis::make(s.point, s.axis), s.radius, s.minor_radius}, frozen,
-                         in);
+            return refine_held(TorusModel{Axis::make(s.point, s.axis), s.radius, s.minor_radius},
+                               frozen, in);
         case FitKind::kShearCylinder:
         case FitKind::kSweptTorus:
         case FitKind::kBSpline:
