@@ -2714,14 +2714,18 @@ std::optional<FitResult> invalid_input(FitKind kind, const FitInput& in) {
     return std::nullopt;
 }
 
+/// The kinds fitted by refining from a start (Levenberg-Marquardt): the ones refit() starts
+/// from a given surface and FitInput::refuse_rms samples first.
+bool refined_kind(FitKind kind) {
+    return kind == FitKind::kSphere || kind == FitKind::kCylinder || kind == FitKind::kCone ||
+           kind == FitKind::kTorus;
+}
+
 }  // namespace
 
 FitResult refit(const Surface& start, const FitInput& in) {
     const FitKind kind = start.kind;
-    if (kind != FitKind::kSphere && kind != FitKind::kCylinder && kind != FitKind::kCone &&
-        kind != FitKind::kTorus) {
-        return fit(kind, in);
-    }
+    if (!refined_kind(kind)) return fit(kind, in);
     if (auto bad = invalid_input(kind, in)) return *bad;
     if (!finite(start.point) || !finite(start.axis) || !std::isfinite(start.radius) ||
         !std::isfinite(start.angle) || !std::isfinite(start.minor_radius) ||
@@ -2756,9 +2760,7 @@ FitResult fit(FitKind kind, const FitInput& in) {
     const std::size_t n = in.points.size();
     if (auto bad = invalid_input(kind, in)) return *bad;
     // The sample: every step-th point, kRefuseSamplePoints or more (FitInput::refuse_rms).
-    const bool sampled = kind == FitKind::kSphere || kind == FitKind::kCylinder ||
-                         kind == FitKind::kCone || kind == FitKind::kTorus;
-    if (sampled && in.refuse_rms > 0 && n >= kSampledFitPoints) {
+    if (refined_kind(kind) && in.refuse_rms > 0 && n >= kSampledFitPoints) {
         const Strided strided(in, n / kRefuseSamplePoints);
         FitInput sample = strided.input(in);
         sample.refuse_rms = 0;
