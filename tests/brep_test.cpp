@@ -31,6 +31,7 @@
 
 #include "ncrev/sample.h"
 #include "ncrev/segment.h"
+#include "scratch.h"
 #include "step_readback.h"
 #include "test_meshes.h"
 
@@ -68,15 +69,7 @@ std::size_t count_faces(const TopoDS_Shape& s) {
     return static_cast<std::size_t>(faces.Extent());
 }
 
-std::filesystem::path out_dir() {
-    static const auto dir = [] {
-        auto d = std::filesystem::temp_directory_path() /
-                 ("ncrev_brep_test_" + std::to_string(::getpid()));
-        std::filesystem::create_directories(d);
-        return d;
-    }();
-    return dir;
-}
+const std::filesystem::path& out_dir() { return test::scratch_dir(); }
 
 Mesh heal(TriangleSoup soup) {
     auto built = build_mesh(std::move(soup));

@@ -16,6 +16,7 @@
 
 #include "ncrev/curvature.h"
 #include "ncrev/io.h"
+#include "scratch.h"
 #include "test_meshes.h"
 
 namespace ncrev {
@@ -29,9 +30,7 @@ struct CliRun {
 CliRun run(const std::string& args) {
     // ctest runs tests in parallel processes: one stderr file per process and call.
     static int calls = 0;
-    const auto err_path =
-        std::filesystem::temp_directory_path() /
-        ("ncrev_cli_test." + std::to_string(::getpid()) + "." + std::to_string(++calls) + ".err");
+    const auto err_path = test::scratch_dir() / ("cli." + std::to_string(++calls) + ".err");
     const std::string cmd = std::string(NCREV_CLI_PATH) + " " + args + " 2>" + err_path.string();
     CliRun r;
     FILE* p = ::popen(cmd.c_str(), "r");
@@ -50,7 +49,7 @@ CliRun run(const std::string& args) {
 }
 
 std::filesystem::path write_temp(const std::string& name, const std::vector<std::byte>& bytes) {
-    const auto path = std::filesystem::temp_directory_path() / name;
+    const auto path = test::scratch_dir() / name;
     EXPECT_TRUE(write_file_atomic(path, bytes).ok());
     return path;
 }
@@ -133,8 +132,8 @@ namespace {
 TEST(CliReverse, WritesAStepAndAReportAndRefusesToOverwriteItsInput) {
     const auto c = test::cube({0, 0, 0}, 10.0);
     const auto stl = write_temp("ncrev_cli_rev_cube.stl", encode_stl_binary(c.points, c.triangles));
-    const auto step = std::filesystem::temp_directory_path() / "ncrev_cli_rev_cube.step";
-    const auto report = std::filesystem::temp_directory_path() / "ncrev_cli_rev_cube.json";
+    const auto step = test::scratch_dir() / "ncrev_cli_rev_cube.step";
+    const auto report = test::scratch_dir() / "ncrev_cli_rev_cube.json";
     std::filesystem::remove(step);
     const CliRun r = run("reverse " + stl.string() + " -o " + step.string() +
                          " --method planar --report " + report.string() + " --json -q");
@@ -158,7 +157,7 @@ TEST(CliReverse, OpenMeshWithRequireSolidExitsThreeAndWritesNothing) {
     auto c = test::cube({0, 0, 0}, 10.0);
     c.triangles.pop_back();
     const auto stl = write_temp("ncrev_cli_rev_open.stl", encode_stl_binary(c.points, c.triangles));
-    const auto step = std::filesystem::temp_directory_path() / "ncrev_cli_rev_open.step";
+    const auto step = test::scratch_dir() / "ncrev_cli_rev_open.step";
     std::filesystem::remove(step);
     const CliRun r = run("reverse " + stl.string() + " -o " + step.string() + " --require-solid");
     EXPECT_EQ(r.code, 3);
@@ -174,7 +173,7 @@ TEST(CliReverse, OpenMeshWithRequireSolidExitsThreeAndWritesNothing) {
 // input order and the regions PLY; --method surfaces refuses an open mesh (exit 3).
 TEST(CliReverse, AutoGivesTheTrueFacesWithLabelsSegmentsAndReport) {
     const auto stl = std::filesystem::path(NCREV_SOURCE_DIR) / "examples" / "pocket_block.stl";
-    const auto dir = std::filesystem::temp_directory_path();
+    const auto dir = test::scratch_dir();
     const auto step = dir / "ncrev_cli_auto.step", labels = dir / "ncrev_cli_auto.labels",
                ply = dir / "ncrev_cli_auto.ply";
     const CliRun r = run("reverse " + stl.string() + " -o " + step.string() + " --labels " +
@@ -250,7 +249,7 @@ std::vector<CurvatureVertex> read_curvature_ply(const std::filesystem::path& pat
 TEST(CliCurvature, WritesTheTypedPlyAndOneJsonDocument) {
     const auto m = test::icosphere(5.0, 5);
     const auto in = write_temp("ncrev_cli_sphere.stl", encode_stl_binary(m.points, m.triangles));
-    const auto out = std::filesystem::temp_directory_path() / "ncrev_cli_sphere.ply";
+    const auto out = test::scratch_dir() / "ncrev_cli_sphere.ply";
     std::filesystem::remove(out);
     const CliRun r = run("curvature " + in.string() + " -o " + out.string() + " --json -q");
     ASSERT_EQ(r.code, 0) << r.err;
@@ -289,7 +288,7 @@ TEST(CliCurvature, WritesTheTypedPlyAndOneJsonDocument) {
 }
 
 TEST(CliCurvature, BadInputAndUsageErrorsWriteNothing) {
-    const auto out = std::filesystem::temp_directory_path() / "ncrev_cli_bad.ply";
+    const auto out = test::scratch_dir() / "ncrev_cli_bad.ply";
     std::filesystem::remove(out);
     const auto bad =
         write_temp("ncrev_cli_bad.stl", test::bytes_of("solid x\n facet normal 0 0 1\n"));
@@ -320,8 +319,7 @@ namespace ncrev {
 namespace {
 
 TEST(CliSegment, WritesRegionsLabelsAndOneJsonDocument) {
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("ncrev_cli_segment." + std::to_string(::getpid()));
+    const auto dir = test::scratch_dir() / "cli_segment";
     std::filesystem::remove_all(dir);
     ASSERT_EQ(run("sample slot_plate -q -o " + dir.string()).code, 0);
     const auto stl = dir / "slot_plate" / "slot_plate.stl";
@@ -396,7 +394,7 @@ TEST(CliSegment, RefusesToOverwriteItsInputAndReportsBadInput) {
     EXPECT_EQ(std::filesystem::file_size(in), before);
     const auto bad =
         write_temp("ncrev_cli_segment_bad.stl", {std::byte{'s'}, std::byte{'o'}, std::byte{'l'}});
-    const auto out = std::filesystem::temp_directory_path() / "ncrev_cli_segment_bad.ply";
+    const auto out = test::scratch_dir() / "ncrev_cli_segment_bad.ply";
     std::filesystem::remove(out);
     const CliRun r = run("segment " + bad.string() + " -o " + out.string());
     EXPECT_EQ(r.code, 2);

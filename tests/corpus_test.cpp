@@ -17,6 +17,7 @@
 #include "ncrev/mesh.h"
 #include "ncrev/report.h"
 #include "ncrev/segment.h"
+#include "scratch.h"
 
 namespace ncrev {
 namespace {
@@ -196,7 +197,7 @@ TEST(Corpus, CoarseFilletStripsAreCylinders) {
 
 /// `mesh` reversed (method auto) into a temporary STEP named after `stem`, removed after.
 ReverseReport reversed(const Mesh& mesh, const std::string& stem) {
-    const auto out = std::filesystem::temp_directory_path() / ("ncrev_" + stem + ".step");
+    const auto out = test::scratch_dir() / ("ncrev_" + stem + ".step");
     ReverseReport r = reverse_to_step(mesh, out).value();
     std::filesystem::remove(out);
     return r;

@@ -27,6 +27,7 @@
 #include "ncrev/mesh.h"
 #include "ncrev/sample.h"
 #include "ncrev/segment.h"
+#include "scratch.h"
 
 namespace ncrev {
 namespace {
@@ -84,9 +85,7 @@ TopoDS_Shape faceted_ball(gp_Pnt o, double r, int rings) {
 // cylinders by their sag (0.27 and 0.17 mm), and their distance to the exact edge where the
 // cylinders meet, 0.43 mm, is more than the deflection the mesh shows elsewhere (0.31 mm).
 TEST(FacetedCuts, CrossedFacetedBoresAreCylinders) {
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("ncrev_faceted_cut_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
+    const auto& dir = test::scratch_dir();
     for (const int sides : {12, 16, 24, 48}) {
         SCOPED_TRACE(std::to_string(sides) + " sides");
         TopoDS_Shape part = BRepPrimAPI_MakeBox(60, 40, 30).Shape();

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "ncrev/io.h"
+#include "scratch.h"
 #include "test_meshes.h"
 
 namespace ncrev {
@@ -205,7 +206,7 @@ TEST(StlReader, EveryPrefixOfAsciiIsAnErrorOrAShorterMesh) {
 }
 
 TEST(StlReader, ReadsFilesThroughThePathOverload) {
-    const auto path = std::filesystem::temp_directory_path() / "ncrev_io_stl_test.stl";
+    const auto path = test::scratch_dir() / "ncrev_io_stl_test.stl";
     ASSERT_TRUE(write_file_atomic(path, cube_binary()).ok());
     auto soup = read_mesh_file(path);
     ASSERT_TRUE(soup.ok()) << soup.error().describe();

@@ -5,6 +5,7 @@
 #include <iterator>
 
 #include "ncrev/io.h"
+#include "scratch.h"
 #include "test_meshes.h"
 
 namespace ncrev {
@@ -16,7 +17,7 @@ std::size_t count_entries(const std::filesystem::path& dir) {
 }
 
 std::filesystem::path temp_dir(const std::string& name) {
-    auto d = std::filesystem::temp_directory_path() / ("ncrev_test_" + name);
+    auto d = test::scratch_dir() / name;
     std::filesystem::remove_all(d);
     std::filesystem::create_directories(d);
     return d;
@@ -75,7 +76,7 @@ TEST(AtomicWrite, ReplacesExistingFileAndLeavesNoTemporary) {
 }
 
 TEST(AtomicWrite, FailsCleanlyInMissingFolder) {
-    const auto path = std::filesystem::temp_directory_path() / "ncrev_no_such_dir" / "x.stl";
+    const auto path = test::scratch_dir() / "no_such_dir" / "x.stl";
     auto s = write_file_atomic(path, std::vector<std::byte>(10));
     ASSERT_FALSE(s.ok());
     EXPECT_EQ(s.error().code, ErrorCode::kCannotWrite);

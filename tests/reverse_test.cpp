@@ -46,20 +46,13 @@
 #include "ncrev/sample.h"
 #include "ncrev/segment.h"
 #include "sample_cases.h"
+#include "scratch.h"
 #include "step_readback.h"
 
 namespace ncrev {
 namespace {
 
-std::filesystem::path out_dir() {
-    static const auto dir = [] {
-        auto d = std::filesystem::temp_directory_path() /
-                 ("ncrev_reverse_test_" + std::to_string(::getpid()));
-        std::filesystem::create_directories(d);
-        return d;
-    }();
-    return dir;
-}
+const std::filesystem::path& out_dir() { return test::scratch_dir(); }
 
 using test::corpus_step_dir;
 using test::corpus_steps;

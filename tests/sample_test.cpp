@@ -26,6 +26,7 @@
 #include "brep/check.h"
 #include "ncrev/io.h"
 #include "ncrev/mesh.h"
+#include "scratch.h"
 
 namespace ncrev {
 namespace {
@@ -36,22 +37,7 @@ using nlohmann::json;
 // feature still has facets of its own.
 constexpr double kCoarseRelativeDeflection = 0.01;
 
-std::filesystem::path test_dir() {
-    static const std::filesystem::path dir = std::filesystem::temp_directory_path() /
-                                             ("ncrev_sample_test_" + std::to_string(::getpid()));
-    return dir;
-}
-
-/// Removes the test folder when the test program ends.
-class RemoveTestDir : public ::testing::Environment {
-   public:
-    void TearDown() override {
-        std::error_code ec;
-        std::filesystem::remove_all(test_dir(), ec);
-    }
-};
-const ::testing::Environment* const kRemoveTestDir =
-    ::testing::AddGlobalTestEnvironment(new RemoveTestDir);
+std::filesystem::path test_dir() { return test::scratch_dir() / "samples"; }
 
 /// Each part at the coarse deflection, built once for all tests.
 const SamplePart& coarse_part(std::string_view name) {

@@ -19,6 +19,7 @@
 #include "ncrev/mesh.h"
 #include "ncrev/sample.h"
 #include "sample_cases.h"
+#include "scratch.h"
 
 namespace ncrev {
 namespace {
@@ -572,7 +573,7 @@ TEST(Segment, FindsTheFacesOfPrismaticCorpusParts) {
         EXPECT_GE(s.kind_right, 0.999) << name;
     }
     // A file that is not STEP is an error that names it.
-    const auto bogus = std::filesystem::temp_directory_path() / "ncrev_not_a_step.step";
+    const auto bogus = test::scratch_dir() / "ncrev_not_a_step.step";
     { std::ofstream(bogus) << "solid x\nendsolid x\n"; }
     const Result<SamplePart> bad = sample_from_step(bogus);
     ASSERT_FALSE(bad.ok());
