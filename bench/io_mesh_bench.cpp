@@ -2,6 +2,8 @@
 // Peers (OpenMesh, CGAL) are in peer_*_bench.cpp, built when installed.
 #include <tbb/global_control.h>
 
+#include <map>
+
 #include "bench_common.h"
 #include "ncrev/mesh.h"
 
@@ -110,6 +112,41 @@ BENCHMARK(BM_BuildMesh)
     ->Args({k5M, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// The same torus with 128 caps stitched in, spread over it: T-junctions closed by zero-area
+// facets, as CAD tessellations make them (BRepMesh's meshes of the samples have tens), which
+// healing removes by splitting the facet beyond each one's long edge. One thread.
+const TriangleSoup& capped_torus_soup(std::size_t facets) {
+    static std::map<std::size_t, TriangleSoup> cache;
+    auto it = cache.find(facets);
+    if (it != cache.end()) return it->second;
+    TriangleSoup s = torus_soup(facets);
+    constexpr std::size_t kCaps = 128;
+    const std::size_t n = s.num_facets();
+    for (std::size_t i = 0; i < kCaps; ++i) {
+        const std::size_t f = (2 * i + 1) * n / (2 * kCaps);
+        const auto [a, b, x] = s.triangles[f];
+        s.points.push_back(0.5 * (s.points[a] + s.points[b]));
+        const auto c = static_cast<std::uint32_t>(s.points.size() - 1);
+        s.triangles[f] = {a, c, x};
+        s.triangles.push_back({c, b, x});
+        s.triangles.push_back({a, b, c});
+    }
+    return cache.emplace(facets, std::move(s)).first->second;
+}
+
+void BM_BuildMeshWithCaps(benchmark::State& state) {
+    const auto n = static_cast<std::size_t>(state.range(0));
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 1);
+    const auto& soup = capped_torus_soup(n);
+    for (auto _ : state) {
+        auto built = build_mesh(soup);
+        if (!built || built->heal.caps_split == 0) state.SkipWithError("no caps split");
+        benchmark::DoNotOptimize(built->mesh.twins().data());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * soup.num_facets()));
+}
+BENCHMARK(BM_BuildMeshWithCaps)->Arg(k100k)->Arg(k1M)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // What `ncrev info` does: read a binary STL file from the page cache, welding exactly while
 // reading, and build the mesh, consuming the soup. Reports the peak heap above the start, per

@@ -479,11 +479,21 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
         const auto key = [](std::uint32_t a, std::uint32_t b) {
             return (std::uint64_t{a} << 32) | b;
         };
-        std::unordered_map<std::uint64_t, std::size_t> owner;  // directed edge -> kept slot
+        // Directed edge -> kept slot, for the edges between two caps' vertices only: every
+        // edge looked up below is one (a cap's three), and the map of all edges was most of
+        // healing on a mesh of a million facets with a few caps (3.5 of 3.7 s).
+        std::vector<std::uint8_t> at_cap(vpos.size(), 0);
+        for (std::size_t k : caps) {
+            for (const std::uint32_t v : tri[kept[k]]) at_cap[v] = 1;
+        }
+        std::unordered_map<std::uint64_t, std::size_t> owner;
+        const auto own = [&](std::uint32_t u, std::uint32_t v, std::size_t k) {
+            if (at_cap[u] && at_cap[v]) owner[key(u, v)] = k;
+        };
         for (std::size_t k = 0; k < kept.size(); ++k) {
             if (bad[k]) continue;
             const auto& t = tri[kept[k]];
-            for (int i = 0; i < 3; ++i) owner[key(t[i], t[(i + 1) % 3])] = k;
+            for (int i = 0; i < 3; ++i) own(t[i], t[(i + 1) % 3], k);
         }
         for (std::size_t k : caps) {
             const auto t = tri[kept[k]];
@@ -512,12 +522,12 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
             bad.push_back(0);
             const std::size_t nk = kept.size() - 1;
             owner.erase(key(b, a));
-            owner[key(b, c)] = n;
-            owner[key(c, d)] = n;
-            owner[key(d, b)] = n;
-            owner[key(c, a)] = nk;
-            owner[key(a, d)] = nk;
-            owner[key(d, c)] = nk;
+            own(b, c, n);
+            own(c, d, n);
+            own(d, b, n);
+            own(c, a, nk);
+            own(a, d, nk);
+            own(d, c, nk);
             ++rep.caps_split;
         }
     };
