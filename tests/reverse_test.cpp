@@ -1289,13 +1289,15 @@ TEST(ReverseStudy, DISABLED_Corpus) {
                         made.error().describe().c_str());
             continue;
         }
-        if (const char* dump = std::getenv("DUMP")) {  // DUMP=dir: the mesh as NAME.stl there
-            const SamplePart& p = made.value();
+        if (const char* dump = std::getenv("DUMP")) {  // DUMP=dir: NAME.stl and NAME.labels
+            const SamplePart& p = made.value();        // (the true face of each facet) there
             const auto bytes = encode_stl_binary(p.mesh.points, p.mesh.triangles);
-            std::ofstream(std::filesystem::path(dump) / (path.stem().string() + ".stl"),
-                          std::ios::binary)
+            const auto stem = std::filesystem::path(dump) / path.stem();
+            std::ofstream(stem.string() + ".stl", std::ios::binary)
                 .write(reinterpret_cast<const char*>(bytes.data()),
                        static_cast<std::streamsize>(bytes.size()));
+            std::ofstream labels(stem.string() + ".labels");
+            for (const std::int32_t l : p.labels) labels << l << '\n';
         }
         const Outcome o = reverse_part(made.value(), false, ReverseMethod::kAuto, "study");
         print_row(path.filename().string(), "STL", o);

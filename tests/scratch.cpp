@@ -10,8 +10,7 @@ namespace ncrev::test {
 namespace {
 
 std::filesystem::path scratch_path() {
-    return std::filesystem::temp_directory_path() /
-           ("ncrev_test." + std::to_string(::getpid()));
+    return std::filesystem::temp_directory_path() / ("ncrev_test." + std::to_string(::getpid()));
 }
 
 /// Removes the folder after the last test; listing the tests never makes it.
