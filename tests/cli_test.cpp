@@ -153,6 +153,49 @@ TEST(CliReverse, WritesAStepAndAReportAndRefusesToOverwriteItsInput) {
     std::filesystem::remove(stl);
 }
 
+// A folder given where a file is to be written is refused before any work (exit 4), not
+// when the result is renamed into place after it; numbers out of range are named plainly.
+TEST(CliReverse, RefusesAFolderForAnOutputAndNamesBadNumbersPlainly) {
+    const auto c = test::cube({0, 0, 0}, 10.0);
+    const auto stl = write_temp("ncrev_cli_dir_cube.stl", encode_stl_binary(c.points, c.triangles));
+    const auto dir = test::scratch_dir() / "a_folder";
+    std::filesystem::create_directories(dir);
+    for (const std::string& args :
+         {"reverse " + stl.string() + " -o " + dir.string(),
+          "reverse " + stl.string() + " -o " + (test::scratch_dir() / "x.step").string() +
+              " --labels " + dir.string(),
+          "segment " + stl.string() + " -o " + dir.string(),
+          "segment " + stl.string() + " -o " + (test::scratch_dir() / "x.ply").string() +
+              " --labels " + dir.string(),
+          "curvature " + stl.string() + " -o " + dir.string()}) {
+        const CliRun r = run(args);
+        EXPECT_EQ(r.code, 4) << args;
+        EXPECT_NE(r.err.find(dir.string() + ": is a directory"), std::string::npos) << r.err;
+        // Refused before reading: the reader's warning (STL has no unit) never came.
+        EXPECT_EQ(r.err.find("no unit"), std::string::npos) << r.err;
+    }
+    EXPECT_TRUE(std::filesystem::is_empty(dir));
+    for (const char* bad : {"-1", "0", "abc", "inf"}) {
+        const CliRun r = run("segment " + stl.string() + " -o " +
+                             (test::scratch_dir() / "x.ply").string() + " --tolerance " + bad);
+        EXPECT_EQ(r.code, 1) << bad;
+        EXPECT_NE(
+            r.err.find(std::string("--tolerance: must be a positive number, got '") + bad + "'"),
+            std::string::npos)
+            << r.err;
+    }
+    // Written as STEP whatever its name, and said so.
+    const auto odd = test::scratch_dir() / "cube.stl";
+    const CliRun named =
+        run("reverse " + stl.string() + " -o " + odd.string() + " --method planar");
+    EXPECT_EQ(named.code, 0) << named.err;
+    EXPECT_NE(named.err.find("written as STEP whatever its name"), std::string::npos) << named.err;
+    std::ifstream written(odd);
+    std::string first;
+    std::getline(written, first);
+    EXPECT_EQ(first.rfind("ISO-10303-21;", 0), 0u) << first;
+}
+
 TEST(CliReverse, OpenMeshWithRequireSolidExitsThreeAndWritesNothing) {
     auto c = test::cube({0, 0, 0}, 10.0);
     c.triangles.pop_back();

@@ -60,11 +60,11 @@ void add_curvature(CLI::App& app, Context& ctx) {
         ->check(CLI::Range(1, 16));
     cmd->add_option("--radius", o->curvature.radius,
                     "Radius of the 'geodesic' neighbourhood, in the file's unit")
-        ->check(CLI::PositiveNumber);
+        ->check(kPositive);
     cmd->add_option("--planar-curvedness", o->curvature.planar_curvedness,
                     "Curvedness (1/unit) below which a vertex is planar (default: from the "
                     "model size and the coordinate precision; the value used is reported)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(kNonNegative);
     cmd->add_option(
            "--sharp-angle", o->sharp_degrees,
            "Dihedral angle in degrees from which an edge is sharp (default " +

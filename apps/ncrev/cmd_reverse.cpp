@@ -1,5 +1,6 @@
 // `ncrev reverse INPUT -o OUTPUT.step [--method auto|surfaces|planar|facets]`: the mesh as a STEP
 // solid.
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -63,7 +64,7 @@ void add_reverse(CLI::App& app, Context& ctx) {
                     "auto/surfaces: largest distance of a vertex from its region's surface, in "
                     "the file's unit (default: 1e-4 x the bounding-box diagonal, raised to the "
                     "noise of a noisy mesh)")
-        ->check(CLI::PositiveNumber);
+        ->check(kPositive);
     cmd->add_flag("--no-surface-indices", o->no_surfaces,
                   "Segment every facet, ignoring the surface indices of an SRE file");
     cmd->add_flag("--no-colors", o->no_colors, "Write plain geometry, without face colors");
@@ -91,9 +92,23 @@ void add_reverse(CLI::App& app, Context& ctx) {
                 ctx.exit_code = kExitUsage;
                 return;
             }
+            if (!extra->empty() && std::filesystem::is_directory(*extra, ec)) {
+                print_error(*extra + ": is a directory; give the path of a file to write");
+                ctx.exit_code = kExitCannotWrite;
+                return;
+            }
         }
         auto healed = read_input(in, out, ctx, o->quiet);
         if (!healed) return;
+        if (std::string ext = out.extension().string(); !o->quiet) {
+            for (char& ch : ext)
+                ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+            if (ext != ".step" && ext != ".stp") {
+                print_warning(o->output +
+                              ": written as STEP whatever its name; CAD systems look for "
+                              ".step or .stp");
+            }
+        }
         const auto progress = terminal_progress(ctx, o->quiet);
         if (o->require_solid && !healed->report.mesh.closed) {
             print_error(o->input + ": the mesh is open (" +

@@ -151,10 +151,10 @@ void add_sample(CLI::App& app, Context& ctx) {
     cmd->add_option("--deflection", opts->deflection,
                     "Chordal deflection in mm (default: 0.0005 x the part's bounding-box "
                     "diagonal, about 0.06 mm for a 100 mm part)")
-        ->check(CLI::PositiveNumber);
+        ->check(kPositive);
     cmd->add_option("--angular", opts->angular,
                     "Angular deflection in radians (default 0.35, about 20 degrees)")
-        ->check(CLI::PositiveNumber);
+        ->check(kPositive);
     cmd->add_option("--seed", opts->seed,
                     "Dimension variant: 0 = nominal dimensions, other values vary them "
                     "deterministically");

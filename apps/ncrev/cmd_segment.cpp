@@ -50,7 +50,7 @@ void add_segment(CLI::App& app, Context& ctx) {
                     "Largest distance of a vertex from its region's surface, in the file's unit "
                     "(default: 1e-4 x the bounding-box diagonal, raised to six times the noise of "
                     "a noisy mesh)")
-        ->check(CLI::PositiveNumber);
+        ->check(kPositive);
     cmd->add_option("--sharp-angle", o->sharp_degrees,
                     "Dihedral angle in degrees from which an edge is sharp (default " +
                         std::to_string(static_cast<int>(
@@ -73,6 +73,11 @@ void add_segment(CLI::App& app, Context& ctx) {
                 std::filesystem::path(o->labels) == out) {
                 print_error("--labels " + o->labels + " would overwrite the input or the output");
                 ctx.exit_code = kExitUsage;
+                return;
+            }
+            if (std::filesystem::is_directory(o->labels, ec)) {
+                print_error(o->labels + ": is a directory; give the path of a file to write");
+                ctx.exit_code = kExitCannotWrite;
                 return;
             }
         }

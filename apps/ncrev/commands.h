@@ -45,6 +45,11 @@ std::vector<Command>& registered_commands();
 std::function<void(std::string_view stage, double fraction)> terminal_progress(const Context& ctx,
                                                                                bool quiet);
 
+/// CLI11's PositiveNumber and NonNegativeNumber with messages a user can read: "must be a
+/// positive number, got -1", not the range up to DBL_MAX written out in full. Finite only.
+extern const CLI::Validator kPositive;
+extern const CLI::Validator kNonNegative;
+
 /// Prints "error: <message>" to stderr.
 void print_error(const std::string& message);
 
@@ -54,8 +59,9 @@ std::string labels_text(const std::vector<std::int32_t>& labels);
 void print_warning(const std::string& message);
 
 /// The start of every command that turns an input mesh into an output file: refuses an output
-/// that is the input (exit 1), then reads and heals the input (exit 2 on a reader error, with
-/// the error printed). Empty when the command must stop; ctx.exit_code is then set.
+/// that is the input (exit 1) or a directory (exit 4), then reads and heals the input (exit 2 on a
+/// reader error, with the error printed). Empty when the command must stop; ctx.exit_code is then
+/// set.
 std::optional<HealedMesh> read_input(const std::filesystem::path& input,
                                      const std::filesystem::path& output, Context& ctx, bool quiet);
 

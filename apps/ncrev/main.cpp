@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -51,6 +52,25 @@ std::string labels_text(const std::vector<std::int32_t>& labels) {
     return s;
 }
 
+namespace {
+CLI::Validator number_at_least(bool zero_too) {
+    const char* what = zero_too ? "a number of at least 0" : "a positive number";
+    return CLI::Validator(
+        [zero_too, what](std::string& text) -> std::string {
+            double v = 0;
+            if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) ||
+                (zero_too ? v < 0 : v <= 0)) {
+                return std::string("must be ") + what + ", got '" + text + "'";
+            }
+            return {};
+        },
+        zero_too ? "NONNEGATIVE" : "POSITIVE");
+}
+}  // namespace
+
+const CLI::Validator kPositive = number_at_least(false);
+const CLI::Validator kNonNegative = number_at_least(true);
+
 void print_error(const std::string& message) {
     std::fprintf(stderr, "error: %s\n", message.c_str());
 }
@@ -61,6 +81,12 @@ std::optional<HealedMesh> read_input(const std::filesystem::path& input,
     if (std::filesystem::exists(output, ec) && std::filesystem::equivalent(input, output, ec)) {
         print_error(output.string() + ": is the input; ncrev never overwrites its input");
         ctx.exit_code = kExitUsage;
+        return std::nullopt;
+    }
+    // Found before the work, not when the result is renamed into place after it.
+    if (std::filesystem::is_directory(output, ec)) {
+        print_error(output.string() + ": is a directory; give the path of a file to write");
+        ctx.exit_code = kExitCannotWrite;
         return std::nullopt;
     }
     auto healed = read_and_heal(input, {}, terminal_progress(ctx, quiet));

@@ -169,9 +169,9 @@ Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& p
     std::error_code ec;
     std::filesystem::rename(tmp, path, ec);
     if (ec) {
+        const std::string why = ec.message();  // before remove() overwrites ec
         std::filesystem::remove(tmp, ec);
-        return write_error(ErrorCode::kCannotWrite, path,
-                           "cannot rename into place: " + ec.message());
+        return write_error(ErrorCode::kCannotWrite, path, "cannot rename into place: " + why);
     }
     return Ok{};
 }
