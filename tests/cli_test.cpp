@@ -158,22 +158,28 @@ TEST(CliReverse, WritesAStepAndAReportAndRefusesToOverwriteItsInput) {
 TEST(CliReverse, RefusesAFolderForAnOutputAndNamesBadNumbersPlainly) {
     const auto c = test::cube({0, 0, 0}, 10.0);
     const auto stl = write_temp("ncrev_cli_dir_cube.stl", encode_stl_binary(c.points, c.triangles));
+    // An input that fails to read: a command that read before it looked at its outputs would
+    // exit 2, not 4.
+    const auto unreadable = test::scratch_dir() / "truncated.stl";
+    { std::ofstream(unreadable) << "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"; }
     const auto dir = test::scratch_dir() / "a_folder";
     std::filesystem::create_directories(dir);
-    for (const std::string& args :
-         {"reverse " + stl.string() + " -o " + dir.string(),
-          "reverse " + stl.string() + " -o " + (test::scratch_dir() / "x.step").string() +
-              " --labels " + dir.string(),
-          "segment " + stl.string() + " -o " + dir.string(),
-          "segment " + stl.string() + " -o " + (test::scratch_dir() / "x.ply").string() +
-              " --labels " + dir.string(),
-          "curvature " + stl.string() + " -o " + dir.string()}) {
-        const CliRun r = run(args);
-        EXPECT_EQ(r.code, 4) << args;
-        EXPECT_NE(r.err.find(dir.string() + ": is a directory"), std::string::npos) << r.err;
-        // Refused before reading: the reader's warning (STL has no unit) never came.
-        EXPECT_EQ(r.err.find("no unit"), std::string::npos) << r.err;
+    const auto step = test::scratch_dir() / "x.step", ply = test::scratch_dir() / "x.ply";
+    for (const auto& in : {stl, unreadable}) {
+        for (const std::string& args :
+             {"reverse " + in.string() + " -o " + dir.string(),
+              "reverse " + in.string() + " -o " + step.string() + " --labels " + dir.string(),
+              "reverse " + in.string() + " -o " + step.string() + " --report " + dir.string(),
+              "segment " + in.string() + " -o " + dir.string(),
+              "segment " + in.string() + " -o " + ply.string() + " --labels " + dir.string(),
+              "curvature " + in.string() + " -o " + dir.string()}) {
+            const CliRun r = run(args);
+            EXPECT_EQ(r.code, 4) << args << "\n" << r.err;
+            EXPECT_NE(r.err.find(dir.string() + ": is a directory"), std::string::npos) << r.err;
+        }
     }
+    EXPECT_FALSE(std::filesystem::exists(step));
+    EXPECT_FALSE(std::filesystem::exists(ply));
     EXPECT_TRUE(std::filesystem::is_empty(dir));
     for (const char* bad : {"-1", "0", "abc", "inf"}) {
         const CliRun r = run("segment " + stl.string() + " -o " +

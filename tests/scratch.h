@@ -8,7 +8,8 @@
 namespace ncrev::test {
 
 /// The folder `ncrev_test.<pid>` under the system's temporary folder, made on first use and
-/// removed (with all it holds) when the test program ends normally.
+/// removed (with all it holds) when the test program ends with every test passed. A test
+/// must not remove it (it is made once per process): use a folder of its own inside.
 const std::filesystem::path& scratch_dir();
 
 }  // namespace ncrev::test

@@ -28,7 +28,8 @@ void add_info(CLI::App& app, Context& ctx) {
                   "Print one JSON object (input, healing, mesh, timing, warnings) on stdout");
     cmd->add_option("--tolerance", opts->tolerance,
                     "Weld distance in model units (default: 1e-6 x bounding-box diagonal, at "
-                    "least 8 float32 ulps of the largest coordinate; 0: exact weld only)");
+                    "least 8 float32 ulps of the largest coordinate; 0: exact weld only)")
+        ->check(kNonNegative);
     cmd->add_flag("-q,--quiet", opts->quiet,
                   "No warnings and no progress on stderr (progress is only shown on a terminal)");
     cmd->callback([opts, &ctx]() {

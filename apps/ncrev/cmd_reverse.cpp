@@ -98,8 +98,6 @@ void add_reverse(CLI::App& app, Context& ctx) {
                 return;
             }
         }
-        auto healed = read_input(in, out, ctx, o->quiet);
-        if (!healed) return;
         if (std::string ext = out.extension().string(); !o->quiet) {
             for (char& ch : ext)
                 ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
@@ -109,6 +107,8 @@ void add_reverse(CLI::App& app, Context& ctx) {
                               ".step or .stp");
             }
         }
+        auto healed = read_input(in, out, ctx, o->quiet);
+        if (!healed) return;
         const auto progress = terminal_progress(ctx, o->quiet);
         if (o->require_solid && !healed->report.mesh.closed) {
             print_error(o->input + ": the mesh is open (" +

@@ -2681,14 +2681,21 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     fix.FixIntersectingWiresMode() = 0;
                     fix.FixLoopWiresMode() = 0;
                     fix.FixSplitFaceMode() = 0;
-                    // Nor the wires' orientation: each loop is walked in the surface's own
-                    // orientation (above), and a wire the wrong way round fails the check below
-                    // (BRepCheck_Analyzer refuses a plane's square bounded clockwise). Telling
+                    // Nor the wires' orientation, but on spheres and tori (surfaces closed both
+                    // ways): each loop is walked in the surface's own orientation (above), and
+                    // on a plane, cylinder, cone or B-spline a wire the wrong way round fails
+                    // the check below (BRepCheck_Analyzer refuses a plane's square bounded
+                    // clockwise). On a sphere or torus a loop the wrong way round would instead
+                    // get the surface's natural bounds added around it (FixAddNaturalBound) and
+                    // pass as the rest of the surface: there the orientation fix stays. Telling
                     // outer from inner (IsOuterBound) was two fifths of the fix, which runs on
-                    // every face, serially, in every round: TR12J's B-rep 6.8-8.4 -> 6.3 s; the
-                    // real STLs' STEP files the same to the byte, the corpus and sample study the
-                    // same row for row.
-                    fix.FixOrientationMode() = 0;
+                    // every face, serially, in every round (docs/benchmarks.md, thirty-fourth
+                    // session).
+                    const bool closed_both_ways = geom[r]->IsUClosed() && geom[r]->IsVClosed();
+                    if (!closed_both_ways &&
+                        !geom[r]->IsKind(STANDARD_TYPE(Geom_SphericalSurface))) {
+                        fix.FixOrientationMode() = 0;
+                    }
                     const Handle(ShapeFix_Wire)& wire_fix = fix.FixWireTool();
                     wire_fix->FixReorderMode() = 0;
                     wire_fix->FixSmallMode() = 0;
