@@ -92,11 +92,7 @@ void add_reverse(CLI::App& app, Context& ctx) {
                 ctx.exit_code = kExitUsage;
                 return;
             }
-            if (!extra->empty() && std::filesystem::is_directory(*extra, ec)) {
-                print_error(*extra + ": is a directory; give the path of a file to write");
-                ctx.exit_code = kExitCannotWrite;
-                return;
-            }
+            if (!extra->empty() && refuses_folder(*extra, ctx)) return;
         }
         if (std::string ext = out.extension().string(); !o->quiet) {
             for (char& ch : ext)

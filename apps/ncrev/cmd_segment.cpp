@@ -75,11 +75,7 @@ void add_segment(CLI::App& app, Context& ctx) {
                 ctx.exit_code = kExitUsage;
                 return;
             }
-            if (std::filesystem::is_directory(o->labels, ec)) {
-                print_error(o->labels + ": is a directory; give the path of a file to write");
-                ctx.exit_code = kExitCannotWrite;
-                return;
-            }
+            if (refuses_folder(o->labels, ctx)) return;
         }
         auto healed = read_input(in, out, ctx, o->quiet);
         if (!healed) return;

@@ -53,6 +53,10 @@ extern const CLI::Validator kNonNegative;
 /// Prints "error: <message>" to stderr.
 void print_error(const std::string& message);
 
+/// True, with the error printed and exit 4 set, when `path` is a directory: an output refused
+/// before any work, not when the result is renamed into place after it.
+bool refuses_folder(const std::filesystem::path& path, Context& ctx);
+
 /// One label per line, in input facet order (`--labels` files).
 std::string labels_text(const std::vector<std::int32_t>& labels);
 /// Prints "warning: <message>" to stderr.

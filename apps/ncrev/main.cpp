@@ -74,6 +74,14 @@ const CLI::Validator kNonNegative = number_at_least(true);
 void print_error(const std::string& message) {
     std::fprintf(stderr, "error: %s\n", message.c_str());
 }
+
+bool refuses_folder(const std::filesystem::path& path, Context& ctx) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(path, ec)) return false;
+    print_error(path.string() + ": is a directory; give the path of a file to write");
+    ctx.exit_code = kExitCannotWrite;
+    return true;
+}
 std::optional<HealedMesh> read_input(const std::filesystem::path& input,
                                      const std::filesystem::path& output, Context& ctx,
                                      bool quiet) {
@@ -83,12 +91,7 @@ std::optional<HealedMesh> read_input(const std::filesystem::path& input,
         ctx.exit_code = kExitUsage;
         return std::nullopt;
     }
-    // Found before the work, not when the result is renamed into place after it.
-    if (std::filesystem::is_directory(output, ec)) {
-        print_error(output.string() + ": is a directory; give the path of a file to write");
-        ctx.exit_code = kExitCannotWrite;
-        return std::nullopt;
-    }
+    if (refuses_folder(output, ctx)) return std::nullopt;
     auto healed = read_and_heal(input, {}, terminal_progress(ctx, quiet));
     if (!healed) {
         print_error(healed.error().describe());

@@ -779,6 +779,23 @@ FitResult fit_plane(const FitInput& in) {
     return residuals(s, in);
 }
 
+FitResult refine_cone(ConeModel& m, const FitInput& in);
+FitResult refine_torus(TorusModel& m, const FitInput& in);
+
+/// A model refined from where it stands, with its kind's checks: what fit() does after its
+/// start, and refit() from a given surface.
+FitResult refine_from(SphereModel m, const FitInput& in) {
+    const int it = refine(m, in);
+    if (m.r < 0) m.r = -m.r;
+    return finish(m, it, in);
+}
+FitResult refine_from(CylinderModel m, const FitInput& in) {
+    const int it = refine(m, in);
+    return finish(m, it, in);
+}
+FitResult refine_from(ConeModel m, const FitInput& in) { return refine_cone(m, in); }
+FitResult refine_from(TorusModel m, const FitInput& in) { return refine_torus(m, in); }
+
 FitResult fit_sphere(const FitInput& in) {
     const Vec3 c0 = centroid(in);
     // Kasa: |q|^2 + D.q + E = 0 for q = p - c0, linear in (D, E).
@@ -796,10 +813,7 @@ FitResult fit_sphere(const FitInput& in) {
     const double r2 = dot(center, center) - x(3);
     if (!x.allFinite() || !(r2 > 0))
         return failed(FitKind::kSphere, "no sphere through the points");
-    SphereModel m{c0 + center, std::sqrt(r2)};
-    const int it = refine(m, in);
-    if (m.r < 0) m.r = -m.r;
-    return finish(m, it, in);
+    return refine_from(SphereModel{c0 + center, std::sqrt(r2)}, in);
 }
 
 /// A fit whose normals make more than 60 degrees on average with the given normals (mean |cos|
@@ -973,9 +987,7 @@ FitResult fit_cylinder(const FitInput& in) {
     // Put the axis point level with the centroid: parameters stay well conditioned.
     const Vec3 g = centroid(in);
     c += dot(g - c, d) * d;
-    CylinderModel m{Axis::make(c, d), sum / total};
-    const int it = refine(m, in);
-    FitResult res = finish(m, it, in);
+    FitResult res = refine_from(CylinderModel{Axis::make(c, d), sum / total}, in);
     // A narrow strip (two rows of a coarse bore, their normals 20 degrees apart) leaves the
     // line that meets the normals ill-determined, and the points also lie on thin cylinders
     // across the strip, whose normals are far from the given ones: also from the direction
@@ -983,12 +995,9 @@ FitResult fit_cylinder(const FitInput& in) {
     Vec3 e;
     CylinderModel m2{};
     if (!second_start(in, res, e, m2)) return res;
-    const int it2 = refine(m2, in);
-    FitResult other = finish(m2, it2, in);
+    FitResult other = refine_from(m2, in);
     return better_fit(other, res, in) ? other : res;
 }
-
-FitResult refine_cone(ConeModel& m, const FitInput& in);
 
 /// The cone about the axis through c along unit d: its generator line rho = r + t h by
 /// weighted least squares in the meridian plane, then refined.
@@ -1110,13 +1119,13 @@ double circle_through(const FitInput& in, Vec3& c, Vec3& d, double& R) {
     return sum / total;
 }
 
-/// Every step-th point, normal (if any) and weight of an input, as an input of its own
-/// (`input()`).
+/// Every step-th point (every point for a step of 0), normal (if any) and weight of an input,
+/// as an input of its own (`input()`).
 struct Strided {
     std::vector<Vec3> points, normals;
     std::vector<double> weights;
     Strided(const FitInput& in, std::size_t step) {
-        step = std::max<std::size_t>(step, 1);  // (callers pass 1 or more)
+        step = std::max<std::size_t>(step, 1);
         for (std::size_t i = 0; i < in.points.size(); i += step) {
             points.push_back(in.points[i]);
             if (!in.normals.empty()) normals.push_back(in.normals[i]);
@@ -1231,7 +1240,7 @@ FitResult fit_torus(const FitInput& in) {
     if (res.ok && in.accept > 0 && res.max <= in.accept) return res;
     const std::size_t n = in.points.size();
     if (in.normals.size() != n || n < 8) return res;
-    const std::size_t step = std::max<std::size_t>(1, n / kSpineSamples);
+    const std::size_t step = n / kSpineSamples;  // 0 or 1: every point
     const Strided strided(in, step);
     const FitInput sample = strided.input(in);
     TorusModel m2{};
@@ -2684,6 +2693,13 @@ FitResult fit_bspline(const FitInput& in, double tolerance) {
 
 namespace {
 
+/// x as a message shows it: six significant digits.
+std::string number(double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", x);
+    return buf;
+}
+
 /// What fit() and refit() ask of every input (matching sizes, finite points, non-negative
 /// weights, points spanning a plane): a failure, or nothing.
 std::optional<FitResult> invalid_input(FitKind kind, const FitInput& in) {
@@ -2721,6 +2737,24 @@ bool refined_kind(FitKind kind) {
            kind == FitKind::kTorus;
 }
 
+/// `f` called with the model a sphere, cylinder, cone or torus `s` is refined as; an empty
+/// result for the other kinds.
+template <class F>
+FitResult with_model(const Surface& s, F&& f) {
+    switch (s.kind) {
+        case FitKind::kSphere:
+            return f(SphereModel{s.point, s.radius});
+        case FitKind::kCylinder:
+            return f(CylinderModel{Axis::make(s.point, s.axis), s.radius});
+        case FitKind::kCone:
+            return f(ConeModel::make(Axis::make(s.point, s.axis), s.radius, s.angle));
+        case FitKind::kTorus:
+            return f(TorusModel{Axis::make(s.point, s.axis), s.radius, s.minor_radius});
+        default:
+            return {};
+    }
+}
+
 }  // namespace
 
 FitResult refit(const Surface& start, const FitInput& in) {
@@ -2732,28 +2766,7 @@ FitResult refit(const Surface& start, const FitInput& in) {
         (kind != FitKind::kSphere && !(norm(start.axis) > 0))) {
         return failed(kind, "the start is not a finite surface");
     }
-    switch (kind) {
-        case FitKind::kSphere: {
-            SphereModel m{start.point, start.radius};
-            const int it = refine(m, in);
-            if (m.r < 0) m.r = -m.r;
-            return finish(m, it, in);
-        }
-        case FitKind::kCylinder: {
-            CylinderModel m{Axis::make(start.point, start.axis), start.radius};
-            const int it = refine(m, in);
-            return finish(m, it, in);
-        }
-        case FitKind::kCone: {
-            ConeModel m =
-                ConeModel::make(Axis::make(start.point, start.axis), start.radius, start.angle);
-            return refine_cone(m, in);
-        }
-        default: {
-            TorusModel m{Axis::make(start.point, start.axis), start.radius, start.minor_radius};
-            return refine_torus(m, in);
-        }
-    }
+    return with_model(start, [&](auto m) { return refine_from(m, in); });
 }
 
 FitResult fit(FitKind kind, const FitInput& in) {
@@ -2766,9 +2779,7 @@ FitResult fit(FitKind kind, const FitInput& in) {
         sample.refuse_rms = 0;
         const FitResult look = fit(kind, sample);
         if (look.ok && look.rms > in.refuse_rms) {
-            char rms[32];
-            std::snprintf(rms, sizeof rms, "%.6g", look.rms);
-            return failed(kind, std::string("a sample of the points is off its fit by RMS ") + rms);
+            return failed(kind, "a sample of the points is off its fit by RMS " + number(look.rms));
         }
     }
     switch (kind) {
@@ -2853,27 +2864,16 @@ FitResult refit_surface(const Surface& s, unsigned frozen, const FitInput& in) {
             return residuals(p, in);
         }
         case FitKind::kSphere:
-            return refine_held(SphereModel{s.point, s.radius}, frozen, in);
         case FitKind::kCylinder:
-            return refine_held(CylinderModel{Axis::make(s.point, s.axis), s.radius}, frozen, in);
         case FitKind::kCone:
-            return refine_held(ConeModel::make(Axis::make(s.point, s.axis), s.radius, s.angle),
-                               frozen, in);
         case FitKind::kTorus:
-            return refine_held(TorusModel{Axis::make(s.point, s.axis), s.radius, s.minor_radius},
-                               frozen, in);
+            return with_model(s, [&](auto m) { return refine_held(m, frozen, in); });
         case FitKind::kShearCylinder:
         case FitKind::kSweptTorus:
         case FitKind::kBSpline:
             break;  // not snapped (yet)
     }
     return {};
-}
-
-std::string number(double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", x);
-    return buf;
 }
 
 }  // namespace
