@@ -113,8 +113,9 @@ struct ReverseReport {
     /// Regions whose own face failed and whose facets joined a neighbour's face (slivers that
     /// lie on the neighbour's surface).
     std::uint64_t absorbed_regions = 0;
-    /// Edges by how their curve was made: intersection, analytic (of them), tangency (a fillet's
-    /// exact contact), fitted, polyline.
+    /// Edges by how their curve was made: intersection, tangency (a fillet's exact contact),
+    /// fitted, polyline; and analytic: of the intersection and tangency edges, those whose
+    /// curve is exact (a line, circle or ellipse, a B-spline extrusion's profile).
     std::map<std::string, std::uint64_t> edges_by_curve;
     std::uint64_t corners = 0;
     /// Of those, the corners put on the contact curve of two tangent surfaces (a fillet and

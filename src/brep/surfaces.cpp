@@ -29,6 +29,7 @@
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
+#include <Eigen/Dense>
 #include <ElSLib.hxx>
 #include <Geom2d_Line.hxx>
 #include <GeomAPI_IntSS.hxx>
@@ -121,6 +122,13 @@ constexpr double kStillSpine = 0.5;
 // both is nearer (a B-spline beside a torus on NIST FTC 10 at 0.02 mm: feet 0.17 mm, 10
 // tolerances, off, and the B-spline's wire crossed itself; 0.03 mm through solved points).
 constexpr double kTouchTolerances = 2;
+// A line or circle is taken for a tangent junction's curve when it passes within this share of
+// the tolerance of every contact point (build_surface_brep()): then it is where the surfaces
+// touch as nearly as the cubic through the points, which passes through them. The contact
+// points of a cylinder fillet on a plane, or of a torus on a plane square to its axis, lie on
+// a line or circle to rounding (1e-11 tolerances on TR12J); a tenth of the tolerance keeps
+// the surfaces' fitting error out of the edge.
+constexpr double kConicFeet = 0.1;
 // Points of a chain used to choose and trim an intersection branch (all when fewer).
 constexpr std::size_t kChainSamples = 24;
 // Facet centroids used to find which way a surface's natural normal points.
@@ -1028,6 +1036,55 @@ bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surfac
     return best_of(lines);
 }
 
+// The line and the circle nearest `points` (least squares; the circle in their best plane,
+// the algebraic fit of its center and radius there), for a chain whose curve may be one:
+// empty for fewer than three points or points all in one place.
+std::vector<Handle(Geom_Curve)> line_and_circle(const std::vector<gp_Pnt>& points) {
+    const std::size_t n = points.size();
+    if (n < 3) return {};
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (const gp_Pnt& p : points) c += Eigen::Vector3d(p.X(), p.Y(), p.Z());
+    c /= static_cast<double>(n);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const gp_Pnt& p : points) {
+        const Eigen::Vector3d d = Eigen::Vector3d(p.X(), p.Y(), p.Z()) - c;
+        cov += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    if (eig.info() != Eigen::Success || !(eig.eigenvalues()(2) > 0)) return {};
+    const Eigen::Vector3d x = eig.eigenvectors().col(2), y = eig.eigenvectors().col(1),
+                          z = eig.eigenvectors().col(0);
+    std::vector<Handle(Geom_Curve)> out;
+    const gp_Pnt center(c(0), c(1), c(2));
+    out.push_back(new Geom_Line(center, gp_Dir(x(0), x(1), x(2))));
+    // x^2 + y^2 + D x + E y + F = 0 in the plane's coordinates, scaled to the points' spread.
+    const double scale = std::sqrt(eig.eigenvalues()(2) / static_cast<double>(n));
+    Eigen::MatrixXd a(static_cast<Eigen::Index>(n), 3);
+    Eigen::VectorXd b(static_cast<Eigen::Index>(n));
+    for (std::size_t i = 0; i < n; ++i) {
+        const Eigen::Vector3d d =
+            (Eigen::Vector3d(points[i].X(), points[i].Y(), points[i].Z()) - c) / scale;
+        const auto k = static_cast<Eigen::Index>(i);
+        a(k, 0) = d.dot(x);
+        a(k, 1) = d.dot(y);
+        a(k, 2) = 1;
+        b(k) = -(a(k, 0) * a(k, 0) + a(k, 1) * a(k, 1));
+    }
+    const Eigen::Vector3d def = a.colPivHouseholderQr().solve(b);
+    const double u0 = -0.5 * def(0), v0 = -0.5 * def(1);
+    const double r2 = u0 * u0 + v0 * v0 - def(2);
+    if (std::isfinite(r2) && r2 > 0 && std::isfinite(u0) && std::isfinite(v0)) {
+        const Eigen::Vector3d o = c + scale * (u0 * x + v0 * y);
+        try {
+            out.push_back(new Geom_Circle(gp_Ax2(gp_Pnt(o(0), o(1), o(2)), gp_Dir(z(0), z(1), z(2)),
+                                                 gp_Dir(x(0), x(1), x(2))),
+                                          scale * std::sqrt(r2)));
+        } catch (const Standard_Failure&) {
+        }
+    }
+    return out;
+}
+
 // A curve through `points` (already on both surfaces): a cubic interpolation, periodic when
 // the chain is closed, or (`linear`) the degree-1 B-spline through them, chord-length knots;
 // or, when `approximate` is positive and the chain open, a C2 B-spline of degree 3 to 8 within
@@ -1059,6 +1116,15 @@ bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, C
         p = std::move(kept);
     }
     if (p.size() < (closed ? 3u : 2u)) return false;
+    // Two points: the segment between them, as a line (the B-spline through them would be one
+    // too, written with two poles and two more on each surface).
+    if (!closed && p.size() == 2) {
+        out.curve = new Geom_Line(p[0], gp_Dir(gp_Vec(p[0], p[1])));
+        out.first = 0;
+        out.last = p[0].Distance(p[1]);
+        out.deviation = 0;
+        return true;
+    }
     // OpenCASCADE throws where it finds the points unfit for a curve (tangency feet heaped on
     // one another, as kStillSpine's were): no curve from these points then, and the caller
     // tries its other points rather than give up the chain.
@@ -1307,6 +1373,7 @@ struct CurveJob {
     gp_Pnt p0, p1;
     ChainCurve cc;
     bool ok = false, intersected = false, touched = false, analytic = false;
+    bool conic = false;  // touched, along a line or circle
 };
 
 // A face's loop on a cylinder, cone or torus, sampled in wire order: the points' surface
@@ -1334,6 +1401,42 @@ gp_Pnt2d revolution_uv(const GeomAdaptor_Surface& s, const gp_Pnt& p, const gp_P
     }
     u += kTurn * std::round((near.X() - u) / kTurn);
     return {u, v};
+}
+
+// The two isolines of `s` (a cylinder, cone, sphere or torus) at `points`' mean parameters:
+// its generator and circle (a cylinder's, a cone's), its meridian and parallel (a sphere's, a
+// torus's). Empty for other surfaces. A contact curve that is one of them lies on `s`
+// exactly, and its curve on `s` is a line of (u, v), which the STEP then carries as such.
+std::vector<Handle(Geom_Curve)> isolines_through(const Handle(Geom_Surface) & s,
+                                                 const std::vector<gp_Pnt>& points) {
+    constexpr double kTurn = 2 * std::numbers::pi;
+    const GeomAdaptor_Surface a(s);
+    const GeomAbs_SurfaceType type = a.GetType();
+    if (points.empty() || (type != GeomAbs_Cylinder && type != GeomAbs_Cone &&
+                           type != GeomAbs_Sphere && type != GeomAbs_Torus)) {
+        return {};
+    }
+    double su = 0, sv = 0;
+    gp_Pnt2d near(0, 0);
+    for (const gp_Pnt& p : points) {
+        gp_Pnt2d uv;
+        if (type == GeomAbs_Sphere) {
+            double u = 0, v = 0;
+            ElSLib::Parameters(a.Sphere(), p, u, v);
+            uv.SetCoord(u + kTurn * std::round((near.X() - u) / kTurn), v);
+        } else {
+            uv = revolution_uv(a, p, near);
+        }
+        near = uv;
+        su += uv.X();
+        sv += uv.Y();
+    }
+    const double n = static_cast<double>(points.size());
+    try {
+        return {s->UIso(su / n), s->VIso(sv / n)};
+    } catch (const Standard_Failure&) {
+        return {};
+    }
 }
 
 // `start`: where the first point's periodic parameters are taken near (a torus's loops all
@@ -2293,7 +2396,39 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     const double stray = 2 * max_tol;
                     ChainCurve best;
                     best.deviation = -1;
-                    if (!touch.empty() &&
+                    Handle(Geom_Curve) conic;
+                    // A line or circle where one runs through the contact points: where the
+                    // tube's spine is a line or circle and the other surface a plane, a tube
+                    // along it or a surface about the same axis (a fillet's edges on a pocket's
+                    // walls and floor), or across the section where two tubes meet. Within
+                    // kConicFeet tolerances of every point; otherwise the cubic through them.
+                    // Not for a region whose wire crossed itself: it gets the piecewise-linear
+                    // curve (below), the retry that the exact curve would leave the same.
+                    if (!touch.empty() && !linear[ra] && !linear[rb]) {
+                        std::vector<Handle(Geom_Curve)> conics = isolines_through(geom[ra], touch);
+                        for (const Handle(Geom_Curve) & c : isolines_through(geom[rb], touch)) {
+                            conics.push_back(c);
+                        }
+                        for (const Handle(Geom_Curve) & c : line_and_circle(touch)) {
+                            conics.push_back(c);
+                        }
+                        for (const Handle(Geom_Curve) & c : conics) {
+                            ChainCurve t;
+                            if (!trim_along(c, touch, ch.closed, t) ||
+                                t.deviation > kConicFeet * opt.tolerance) {
+                                continue;
+                            }
+                            t.deviation = curve_off_surfaces(t, sa, sb, samples);
+                            if (t.deviation <= kTouchTolerances * opt.tolerance &&
+                                !strays_from(t, touch, stray)) {
+                                best = t;
+                                touched = true;
+                                conic = t.curve;
+                                break;
+                            }
+                        }
+                    }
+                    if (!touched && !touch.empty() &&
                         fitted_curve(touch, ch.closed, linear[ra] || linear[rb], best)) {
                         best.deviation = curve_off_surfaces(best, sa, sb, samples);
                         touched = best.deviation <= kTouchTolerances * opt.tolerance &&
@@ -2372,6 +2507,8 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                         ok = ok || taken;
                     }
                     if (ok) cc = best;
+                    // Exact, unless the curve through the midway points replaced it.
+                    job.analytic = ok && !conic.IsNull() && best.curve == conic;
                 }
             } catch (const Standard_Failure&) {
                 ok = false;

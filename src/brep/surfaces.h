@@ -80,9 +80,9 @@ struct SurfaceBrep {
     /// onto both surfaces: other tangent junctions, failed intersections), "polyline" (beside a
     /// fallback).
     std::uint64_t intersection_edges = 0, tangency_edges = 0, fitted_edges = 0, polyline_edges = 0;
-    /// Of the intersection edges, those whose curve is exact (IntAna: a line, circle or
-    /// ellipse where two elementary surfaces meet; a B-spline extrusion's profile moved onto a
-    /// plane).
+    /// Of the intersection and tangency edges, those whose curve is exact: a line, circle or
+    /// ellipse where two elementary surfaces meet (IntAna), a B-spline extrusion's profile
+    /// moved onto a plane, a line or circle through a fillet's contact points.
     std::uint64_t analytic_edges = 0;
     std::uint64_t corners = 0;
     /// Of those, the corners put on the contact curve of two tangent surfaces.
