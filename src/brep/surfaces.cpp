@@ -1038,7 +1038,8 @@ bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surfac
 
 // The line and the circle nearest `points` (least squares; the circle in their best plane,
 // the algebraic fit of its center and radius there), for a chain whose curve may be one:
-// empty for fewer than three points or points all in one place.
+// empty for fewer than three points or points all in one place; no circle for three (it
+// would pass through them whatever they are).
 std::vector<Handle(Geom_Curve)> line_and_circle(const std::vector<gp_Pnt>& points) {
     const std::size_t n = points.size();
     if (n < 3) return {};
@@ -1057,6 +1058,7 @@ std::vector<Handle(Geom_Curve)> line_and_circle(const std::vector<gp_Pnt>& point
     std::vector<Handle(Geom_Curve)> out;
     const gp_Pnt center(c(0), c(1), c(2));
     out.push_back(new Geom_Line(center, gp_Dir(x(0), x(1), x(2))));
+    if (n < 4) return out;
     // x^2 + y^2 + D x + E y + F = 0 in the plane's coordinates, scaled to the points' spread.
     const double scale = std::sqrt(eig.eigenvalues()(2) / static_cast<double>(n));
     Eigen::MatrixXd a(static_cast<Eigen::Index>(n), 3);
@@ -1116,15 +1118,6 @@ bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, C
         p = std::move(kept);
     }
     if (p.size() < (closed ? 3u : 2u)) return false;
-    // Two points: the segment between them, as a line (the B-spline through them would be one
-    // too, written with two poles and two more on each surface).
-    if (!closed && p.size() == 2) {
-        out.curve = new Geom_Line(p[0], gp_Dir(gp_Vec(p[0], p[1])));
-        out.first = 0;
-        out.last = p[0].Distance(p[1]);
-        out.deviation = 0;
-        return true;
-    }
     // OpenCASCADE throws where it finds the points unfit for a curve (tangency feet heaped on
     // one another, as kStillSpine's were): no curve from these points then, and the caller
     // tries its other points rather than give up the chain.
@@ -1163,6 +1156,15 @@ bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, C
             if (closed || p.size() <= kApproximateFrom) return false;
             GeomAPI_PointsToBSpline fit(arr->Array1(), 3, 8, GeomAbs_C2, approximate);
             return fit.IsDone() && whole(fit.Curve());
+        }
+        // Two points: the segment between them, as a line (the cubic through them is that
+        // segment too, written with four poles and as many on each surface).
+        if (!closed && p.size() == 2) {
+            out.curve = new Geom_Line(p[0], gp_Dir(gp_Vec(p[0], p[1])));
+            out.first = 0;
+            out.last = p[0].Distance(p[1]);
+            out.deviation = 0;
+            return true;
         }
         GeomAPI_Interpolate interp(arr, closed, kMinTolerance);
         interp.Perform();
@@ -1437,6 +1439,28 @@ std::vector<Handle(Geom_Curve)> isolines_through(const Handle(Geom_Surface) & s,
     } catch (const Standard_Failure&) {
         return {};
     }
+}
+
+// The first of the isolines of `ga` and of `gb` through `points` (isolines_through()), then
+// their least-squares line and circle (line_and_circle()), that passes within `feet` of every
+// point, within `off` of both surfaces (curve_off_surfaces(), its deviation in `out`) and
+// never farther than `stray` from the points' polyline; false when none does.
+bool conic_through(const std::vector<gp_Pnt>& points, bool closed, const Handle(Geom_Surface) & ga,
+                   const Handle(Geom_Surface) & gb, const Surface& sa, const Surface& sb,
+                   double feet, double off, double stray, int samples, ChainCurve& out) {
+    std::vector<Handle(Geom_Curve)> conics = isolines_through(ga, points);
+    for (const Handle(Geom_Curve) & c : isolines_through(gb, points)) conics.push_back(c);
+    for (const Handle(Geom_Curve) & c : line_and_circle(points)) conics.push_back(c);
+    for (const Handle(Geom_Curve) & c : conics) {
+        ChainCurve t;
+        if (!trim_along(c, points, closed, t) || t.deviation > feet) continue;
+        t.deviation = curve_off_surfaces(t, sa, sb, samples);
+        if (t.deviation <= off && !strays_from(t, points, stray)) {
+            out = t;
+            return true;
+        }
+    }
+    return false;
 }
 
 // `start`: where the first point's periodic parameters are taken near (a torus's loops all
@@ -2370,6 +2394,19 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     ok = intersection_curve(geom[ra], geom[rb], sa, sb, pts, ch.closed,
                                             opt.chordal_deflection + opt.tolerance, cc, analytic);
                     intersected = ok;
+                    // A general intersection (a B-spline of many poles) that is a line or
+                    // circle to a tenth of the tolerance, and as near both surfaces: that line
+                    // or circle (a plane across a torus square to its axis but for the fits'
+                    // error, two cylinders whose axes all but meet).
+                    ChainCurve simple;
+                    if (ok && !analytic &&
+                        conic_through(pts, ch.closed, geom[ra], geom[rb], sa, sb,
+                                      kConicFeet * opt.tolerance, kConicFeet * opt.tolerance,
+                                      opt.chordal_deflection + opt.tolerance,
+                                      4 * static_cast<int>(pts.size()), simple)) {
+                        cc = simple;
+                        analytic = true;
+                    }
                     job.analytic = ok && analytic;
                 }
                 if (!ok) {
@@ -2404,29 +2441,12 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                     // kConicFeet tolerances of every point; otherwise the cubic through them.
                     // Not for a region whose wire crossed itself: it gets the piecewise-linear
                     // curve (below), the retry that the exact curve would leave the same.
-                    if (!touch.empty() && !linear[ra] && !linear[rb]) {
-                        std::vector<Handle(Geom_Curve)> conics = isolines_through(geom[ra], touch);
-                        for (const Handle(Geom_Curve) & c : isolines_through(geom[rb], touch)) {
-                            conics.push_back(c);
-                        }
-                        for (const Handle(Geom_Curve) & c : line_and_circle(touch)) {
-                            conics.push_back(c);
-                        }
-                        for (const Handle(Geom_Curve) & c : conics) {
-                            ChainCurve t;
-                            if (!trim_along(c, touch, ch.closed, t) ||
-                                t.deviation > kConicFeet * opt.tolerance) {
-                                continue;
-                            }
-                            t.deviation = curve_off_surfaces(t, sa, sb, samples);
-                            if (t.deviation <= kTouchTolerances * opt.tolerance &&
-                                !strays_from(t, touch, stray)) {
-                                best = t;
-                                touched = true;
-                                conic = t.curve;
-                                break;
-                            }
-                        }
+                    if (!touch.empty() && !linear[ra] && !linear[rb] &&
+                        conic_through(touch, ch.closed, geom[ra], geom[rb], sa, sb,
+                                      kConicFeet * opt.tolerance, kTouchTolerances * opt.tolerance,
+                                      stray, samples, best)) {
+                        touched = true;
+                        conic = best.curve;
                     }
                     if (!touched && !touch.empty() &&
                         fitted_curve(touch, ch.closed, linear[ra] || linear[rb], best)) {
