@@ -302,6 +302,22 @@ TEST(ReverseSurfaces, FacesHaveTheirTrueKinds) {
     EXPECT_LE(std::abs(o.report.volume_difference), 1e-3);
 }
 
+// A shape's edges (not degenerated) and, of them, those whose curve is not a line, circle or
+// ellipse.
+std::pair<std::size_t, std::size_t> edges_and_splines(const TopoDS_Shape& shape) {
+    TopTools_IndexedMapOfShape all;
+    TopExp::MapShapes(shape, TopAbs_EDGE, all);
+    std::size_t edges = 0, splines = 0;
+    for (int i = 1; i <= all.Extent(); ++i) {
+        const TopoDS_Edge& e = TopoDS::Edge(all(i));
+        if (BRep_Tool::Degenerated(e)) continue;
+        ++edges;
+        const GeomAbs_CurveType type = BRepAdaptor_Curve(e).GetType();
+        if (type != GeomAbs_Line && type != GeomAbs_Circle && type != GeomAbs_Ellipse) ++splines;
+    }
+    return {edges, splines};
+}
+
 // Fillets meet their neighbours where the tube's spine has its foot on them: the pocket
 // block's 8 corner cylinders and 4 floor tori are tangent to the walls and the floor, and those
 // junctions get curves through the exact contact points, close to both surfaces.
@@ -317,20 +333,27 @@ TEST(ReverseSurfaces, FilletJunctionsFollowTheExactContact) {
     // the block's 60 edges 32 were B-splines; 4 are left: the corner cylinders' junctions
     // with the floor tori, whose contact points lie up to a tolerance off any circle, and
     // whose edges are fitted to points on both surfaces.
-    TopTools_IndexedMapOfShape all;
-    TopExp::MapShapes(o.back.shape, TopAbs_EDGE, all);
-    std::size_t edges = 0, splines = 0;
-    for (int i = 1; i <= all.Extent(); ++i) {
-        const TopoDS_Edge& e = TopoDS::Edge(all(i));
-        if (BRep_Tool::Degenerated(e)) continue;
-        ++edges;
-        const GeomAbs_CurveType type = BRepAdaptor_Curve(e).GetType();
-        if (type != GeomAbs_Line && type != GeomAbs_Circle && type != GeomAbs_Ellipse) ++splines;
-    }
+    const auto [edges, splines] = edges_and_splines(o.back.shape);
     EXPECT_GT(edges, 0u);
     EXPECT_LE(splines, 4u) << "of " << edges << " edges";
     // The report counts them with the exact intersections.
     EXPECT_GT(o.report.edges_by_curve.at("analytic"), o.report.edges_by_curve.at("intersection"));
+}
+
+// The same on a finely meshed part (the fillet block at 1e-5 of its diagonal, about 48k
+// facets), whose borders zigzag across the fillets' contact lines: the contact points step
+// back and forth along a line or circle, and that line or circle is still the edge. Of the
+// block's 56 edges about 40 were B-splines; 5 are (8 while a point that stepped back made the
+// line or circle look doubled back).
+TEST(ReverseSurfaces, FinelyMeshedFilletJunctionsAreLinesAndCircles) {
+    const Outcome o = reverse_part(make("fillet_chamfer_block", 1e-5), false, ReverseMethod::kAuto,
+                                   "fillet_block_fine_edges");
+    expect_solid(o, "fillet_chamfer_block");
+    EXPECT_GT(o.mesh.faces, 40000u);
+    EXPECT_EQ(o.report.faces, o.true_faces);
+    const auto [edges, splines] = edges_and_splines(o.back.shape);
+    EXPECT_GT(edges, 0u);
+    EXPECT_LE(splines, 5u) << "of " << edges << " edges";
 }
 
 // SRE tool colors are written as the faces' colors.

@@ -1087,6 +1087,22 @@ std::vector<Handle(Geom_Curve)> line_and_circle(const std::vector<gp_Pnt>& point
     return out;
 }
 
+// `points` without those behind their neighbours, where the polyline through them would turn
+// back by more than a right angle; the first point is always kept, the last may replace the
+// points before it.
+std::vector<gp_Pnt> forward_points(const std::vector<gp_Pnt>& points) {
+    std::vector<gp_Pnt> kept;
+    kept.reserve(points.size());
+    for (const gp_Pnt& q : points) {
+        while (kept.size() >= 2 &&
+               gp_Vec(kept[kept.size() - 2], kept.back()).Dot(gp_Vec(kept.back(), q)) < 0) {
+            kept.pop_back();
+        }
+        kept.push_back(q);
+    }
+    return kept;
+}
+
 // A curve through `points` (already on both surfaces): a cubic interpolation, periodic when
 // the chain is closed, or (`linear`) the degree-1 B-spline through them, chord-length knots;
 // or, when `approximate` is positive and the chain open, a C2 B-spline of degree 3 to 8 within
@@ -1100,23 +1116,10 @@ bool fitted_curve(const std::vector<gp_Pnt>& points, bool closed, bool linear, C
         if (p.empty() || p.back().Distance(q) > 10 * kMinTolerance) p.push_back(q);
     }
     if (closed && p.size() > 1 && p.back().Distance(p.front()) <= 10 * kMinTolerance) p.pop_back();
-    if (!closed) {
-        // A chain point behind its neighbours (the curve would turn back by more than a right
-        // angle there) is dropped: a corner solved a little past the chain's first interior
-        // vertex, or an interior point that slid along a tangent junction, would otherwise
-        // fold the curve back on itself (a self-intersecting wire on the surface).
-        std::vector<gp_Pnt> kept;
-        kept.reserve(p.size());
-        for (const gp_Pnt& q : p) {
-            // kept[0] is the chain's first end and never dropped; `q` may be the last.
-            while (kept.size() >= 2 &&
-                   gp_Vec(kept[kept.size() - 2], kept.back()).Dot(gp_Vec(kept.back(), q)) < 0) {
-                kept.pop_back();
-            }
-            kept.push_back(q);
-        }
-        p = std::move(kept);
-    }
+    // A chain point behind its neighbours is dropped: a corner solved a little past the chain's
+    // first interior vertex, or an interior point that slid along a tangent junction, would
+    // otherwise fold the curve back on itself (a self-intersecting wire on the surface).
+    if (!closed) p = forward_points(p);
     if (p.size() < (closed ? 3u : 2u)) return false;
     // OpenCASCADE throws where it finds the points unfit for a curve (tangency feet heaped on
     // one another, as kStillSpine's were): no curve from these points then, and the caller
@@ -1451,9 +1454,24 @@ bool conic_through(const std::vector<gp_Pnt>& points, bool closed, const Handle(
     std::vector<Handle(Geom_Curve)> conics = isolines_through(ga, points);
     for (const Handle(Geom_Curve) & c : isolines_through(gb, points)) conics.push_back(c);
     for (const Handle(Geom_Curve) & c : line_and_circle(points)) conics.push_back(c);
+    // Trimmed at an open chain's points with those that go back dropped (forward_points()): a
+    // fine mesh's border zigzags across the contact, and its feet, along a line or circle,
+    // step back and forth on it (the fillet block at 950k facets). Within `feet` of them all.
+    const std::vector<gp_Pnt> ahead = closed ? points : forward_points(points);
     for (const Handle(Geom_Curve) & c : conics) {
         ChainCurve t;
-        if (!trim_along(c, points, closed, t) || t.deviation > feet) continue;
+        if (!trim_along(c, ahead, closed, t) || t.deviation > feet) continue;
+        bool near = true;
+        if (ahead.size() < points.size()) {
+            for (const gp_Pnt& p : points) {
+                GeomAPI_ProjectPointOnCurve proj(p, t.curve);
+                if (proj.NbPoints() == 0 || proj.LowerDistance() > feet) {
+                    near = false;
+                    break;
+                }
+            }
+        }
+        if (!near) continue;
         t.deviation = curve_off_surfaces(t, sa, sb, samples);
         if (t.deviation <= off && !strays_from(t, points, stray)) {
             out = t;
