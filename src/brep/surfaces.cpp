@@ -1378,7 +1378,6 @@ struct CurveJob {
     gp_Pnt p0, p1;
     ChainCurve cc;
     bool ok = false, intersected = false, touched = false, analytic = false;
-    bool conic = false;  // touched, along a line or circle
 };
 
 // A face's loop on a cylinder, cone or torus, sampled in wire order: the points' surface
@@ -1444,6 +1443,22 @@ std::vector<Handle(Geom_Curve)> isolines_through(const Handle(Geom_Surface) & s,
     }
 }
 
+// The distance from `p` to the piece [first, last] of the line or circle `t`: to its nearest
+// normal projection within the piece, or to the nearer end.
+double distance_to_piece(const ChainCurve& t, const gp_Pnt& p) {
+    double d = std::min(p.Distance(t.curve->Value(t.first)), p.Distance(t.curve->Value(t.last)));
+    GeomAPI_ProjectPointOnCurve proj(p, t.curve);
+    for (int i = 1; i <= proj.NbPoints(); ++i) {
+        double u = proj.Parameter(i);
+        if (t.curve->IsPeriodic()) {
+            const double period = t.curve->Period();
+            u += period * std::ceil((t.first - u) / period);  // the first turn at or past `first`
+        }
+        if (u >= t.first && u <= t.last) d = std::min(d, proj.Distance(i));
+    }
+    return d;
+}
+
 // The first of the isolines of `ga` and of `gb` through `points` (isolines_through()), then
 // their least-squares line and circle (line_and_circle()), that passes within `feet` of every
 // point, within `off` of both surfaces (curve_off_surfaces(), its deviation in `out`) and
@@ -1456,22 +1471,17 @@ bool conic_through(const std::vector<gp_Pnt>& points, bool closed, const Handle(
     for (const Handle(Geom_Curve) & c : line_and_circle(points)) conics.push_back(c);
     // Trimmed at an open chain's points with those that go back dropped (forward_points()): a
     // fine mesh's border zigzags across the contact, and its feet, along a line or circle,
-    // step back and forth on it (the fillet block at 950k facets). Within `feet` of them all.
+    // step back and forth on it (the fillet block at 950k facets). Within `feet` of them all,
+    // measured to the trimmed piece (distance_to_piece()).
     const std::vector<gp_Pnt> ahead = closed ? points : forward_points(points);
     for (const Handle(Geom_Curve) & c : conics) {
         ChainCurve t;
         if (!trim_along(c, ahead, closed, t) || t.deviation > feet) continue;
-        bool near = true;
-        if (ahead.size() < points.size()) {
-            for (const gp_Pnt& p : points) {
-                GeomAPI_ProjectPointOnCurve proj(p, t.curve);
-                if (proj.NbPoints() == 0 || proj.LowerDistance() > feet) {
-                    near = false;
-                    break;
-                }
-            }
+        if (ahead.size() < points.size() &&
+            !std::all_of(points.begin(), points.end(),
+                         [&](const gp_Pnt& p) { return distance_to_piece(t, p) <= feet; })) {
+            continue;
         }
-        if (!near) continue;
         t.deviation = curve_off_surfaces(t, sa, sb, samples);
         if (t.deviation <= off && !strays_from(t, points, stray)) {
             out = t;
