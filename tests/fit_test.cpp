@@ -213,6 +213,34 @@ std::vector<Patch> target_patches(test::Rng& rng, std::size_t n = 1000) {
             torus_patch(rng, 10, 4, 360, 360, n)};
 }
 
+// The least-squares line and circle the B-rep tries for an edge: points on an arc of a tilted
+// circle give its center, normal and radius; points on a line give it; points all in one place
+// no line.
+TEST(Fit, LineAndCircleThroughPoints) {
+    const Vec3 center{1, -2, 3}, n = normalized(Vec3{1, 2, 2});
+    const Vec3 u = normalized(cross(n, Vec3{0, 0, 1})), v = cross(n, u);
+    std::vector<Vec3> arc;
+    for (int i = 0; i <= 8; ++i) {
+        const double t = 0.1 * i;  // under a radian and a half of the circle
+        arc.push_back(center + 7.5 * (std::cos(t) * u + std::sin(t) * v));
+    }
+    Vec3 c, normal;
+    double r = 0;
+    EXPECT_LT(fit_circle(arc, c, normal, r), 1e-20);
+    EXPECT_NEAR(r, 7.5, 1e-9);
+    EXPECT_LT(norm(c - center), 1e-9);
+    EXPECT_NEAR(std::abs(dot(normal, n)), 1.0, 1e-12);
+
+    std::vector<Vec3> line;
+    for (int i = 0; i < 5; ++i) line.push_back(center + (0.5 * i) * u);
+    Vec3 at, along;
+    ASSERT_TRUE(fit_line(line, at, along));
+    EXPECT_NEAR(std::abs(dot(along, u)), 1.0, 1e-12);
+    EXPECT_LT(norm(cross(at - center, u)), 1e-12);
+    const std::vector<Vec3> one(3, center);
+    EXPECT_FALSE(fit_line(one, at, along));
+}
+
 TEST(Fit, ExactPatchesGiveTheirParameters) {
     test::Rng rng(11);
     for (const Patch& p : target_patches(rng)) {

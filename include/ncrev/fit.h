@@ -210,6 +210,16 @@ FitResult fit_helical(const FitInput& input, double tolerance);
 /// over their plane or no net reaches the tolerance.
 FitResult fit_bspline(const FitInput& input, double tolerance);
 
+/// The line nearest `points` in least squares: through their centroid along their principal
+/// direction (unit). False when they all coincide.
+bool fit_line(std::span<const Vec3> points, Vec3& point, Vec3& direction);
+
+/// The circle nearest `points`: its plane by principal components (`normal`, unit), the circle
+/// in it by Kasa's algebraic fit. Returns the mean squared distance of the points from it;
+/// infinite when there is none. Through any three points not on a line; for points on a line
+/// it is ill-conditioned (a circle of any huge radius): fit a line first.
+double fit_circle(std::span<const Vec3> points, Vec3& center, Vec3& normal, double& radius);
+
 /// The simplest kind whose fit keeps every point within `tolerance` (max residual), in the
 /// order plane, sphere, cylinder, cone, torus, so that a plane is not called a cylinder of huge
 /// radius, nor a cylinder a cone of tiny angle; unless a kind with more parameters fits clearly

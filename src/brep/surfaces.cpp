@@ -29,7 +29,6 @@
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
-#include <Eigen/Dense>
 #include <ElSLib.hxx>
 #include <Geom2d_Line.hxx>
 #include <GeomAPI_IntSS.hxx>
@@ -126,8 +125,8 @@ constexpr double kTouchTolerances = 2;
 // the tolerance of every contact point (build_surface_brep()): then it is where the surfaces
 // touch as nearly as the cubic through the points, which passes through them. The contact
 // points of a cylinder fillet on a plane, or of a torus on a plane square to its axis, lie on
-// a line or circle to rounding (1e-11 tolerances on TR12J); a tenth of the tolerance keeps
-// the surfaces' fitting error out of the edge.
+// a line or circle to rounding (the spine's projection onto the plane); a tenth of the
+// tolerance keeps the surfaces' fitting error out of the edge.
 constexpr double kConicFeet = 0.1;
 // Points of a chain used to choose and trim an intersection branch (all when fewer).
 constexpr std::size_t kChainSamples = 24;
@@ -1036,53 +1035,23 @@ bool intersection_curve(const Handle(Geom_Surface) & a, const Handle(Geom_Surfac
     return best_of(lines);
 }
 
-// The line and the circle nearest `points` (least squares; the circle in their best plane,
-// the algebraic fit of its center and radius there), for a chain whose curve may be one:
-// empty for fewer than three points or points all in one place; no circle for three (it
-// would pass through them whatever they are).
+// The line and the circle nearest `points` (fit_line(), fit_circle()), for a chain whose curve
+// may be one: empty for fewer than three points or points all in one place; no circle for
+// three (it would pass through them whatever they are).
 std::vector<Handle(Geom_Curve)> line_and_circle(const std::vector<gp_Pnt>& points) {
-    const std::size_t n = points.size();
-    if (n < 3) return {};
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (const gp_Pnt& p : points) c += Eigen::Vector3d(p.X(), p.Y(), p.Z());
-    c /= static_cast<double>(n);
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (const gp_Pnt& p : points) {
-        const Eigen::Vector3d d = Eigen::Vector3d(p.X(), p.Y(), p.Z()) - c;
-        cov += d * d.transpose();
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    if (eig.info() != Eigen::Success || !(eig.eigenvalues()(2) > 0)) return {};
-    const Eigen::Vector3d x = eig.eigenvectors().col(2), y = eig.eigenvectors().col(1),
-                          z = eig.eigenvectors().col(0);
+    if (points.size() < 3) return {};
+    std::vector<Vec3> p;
+    p.reserve(points.size());
+    for (const gp_Pnt& q : points) p.push_back(vec(q));
     std::vector<Handle(Geom_Curve)> out;
-    const gp_Pnt center(c(0), c(1), c(2));
-    out.push_back(new Geom_Line(center, gp_Dir(x(0), x(1), x(2))));
-    if (n < 4) return out;
-    // x^2 + y^2 + D x + E y + F = 0 in the plane's coordinates, scaled to the points' spread.
-    const double scale = std::sqrt(eig.eigenvalues()(2) / static_cast<double>(n));
-    Eigen::MatrixXd a(static_cast<Eigen::Index>(n), 3);
-    Eigen::VectorXd b(static_cast<Eigen::Index>(n));
-    for (std::size_t i = 0; i < n; ++i) {
-        const Eigen::Vector3d d =
-            (Eigen::Vector3d(points[i].X(), points[i].Y(), points[i].Z()) - c) / scale;
-        const auto k = static_cast<Eigen::Index>(i);
-        a(k, 0) = d.dot(x);
-        a(k, 1) = d.dot(y);
-        a(k, 2) = 1;
-        b(k) = -(a(k, 0) * a(k, 0) + a(k, 1) * a(k, 1));
-    }
-    const Eigen::Vector3d def = a.colPivHouseholderQr().solve(b);
-    const double u0 = -0.5 * def(0), v0 = -0.5 * def(1);
-    const double r2 = u0 * u0 + v0 * v0 - def(2);
-    if (std::isfinite(r2) && r2 > 0 && std::isfinite(u0) && std::isfinite(v0)) {
-        const Eigen::Vector3d o = c + scale * (u0 * x + v0 * y);
-        try {
-            out.push_back(new Geom_Circle(gp_Ax2(gp_Pnt(o(0), o(1), o(2)), gp_Dir(z(0), z(1), z(2)),
-                                                 gp_Dir(x(0), x(1), x(2))),
-                                          scale * std::sqrt(r2)));
-        } catch (const Standard_Failure&) {
-        }
+    Vec3 at, along;
+    if (!fit_line(p, at, along)) return out;
+    out.push_back(new Geom_Line(pnt(at), gp_Dir(along.x, along.y, along.z)));
+    Vec3 center, normal;
+    double radius = 0;
+    if (p.size() >= 4 && std::isfinite(fit_circle(p, center, normal, radius)) && radius > 0) {
+        out.push_back(
+            new Geom_Circle(gp_Ax2(pnt(center), gp_Dir(normal.x, normal.y, normal.z)), radius));
     }
     return out;
 }

@@ -2489,6 +2489,25 @@ FitResult fit_swept_torus(const FitInput& in) {
 
 }  // namespace
 
+bool fit_line(std::span<const Vec3> points, Vec3& point, Vec3& direction) {
+    FitInput in;
+    in.points = points;
+    double total = 0;
+    point = centroid(in, &total);
+    if (!(total > 0)) return false;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es = principal_axes(in, point);
+    if (es.info() != Eigen::Success || !(es.eigenvalues()(2) > 0)) return false;
+    direction =
+        normalized(Vec3{es.eigenvectors()(0, 2), es.eigenvectors()(1, 2), es.eigenvectors()(2, 2)});
+    return true;
+}
+
+double fit_circle(std::span<const Vec3> points, Vec3& center, Vec3& normal, double& radius) {
+    FitInput in;
+    in.points = points;
+    return circle_through(in, center, normal, radius);
+}
+
 double distance(const Surface& s, Vec3 p) { return norm(p - closest_point(s, p)); }
 
 namespace {
