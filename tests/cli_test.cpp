@@ -367,6 +367,39 @@ TEST(CliCurvature, BadInputAndUsageErrorsWriteNothing) {
 namespace ncrev {
 namespace {
 
+// The spherical pocket's end walls are 2-facet planes whose vertices an intersection put 1e-7
+// off x = 0 and x = 90: fitted, a normal leans by 4e-9; snapped (the default), they are exactly
+// -x and +x; --no-snap keeps the fits.
+TEST(CliSegment, SnapsToRoundValuesUnlessTold) {
+    const auto dir = test::scratch_dir() / "cli_segment_snap";
+    std::filesystem::remove_all(dir);
+    ASSERT_EQ(run("sample spherical_pocket -q -o " + dir.string()).code, 0);
+    const auto stl = dir / "spherical_pocket" / "spherical_pocket.stl";
+    const auto ply = dir / "regions.ply";
+    auto leaning_planes = [](const nlohmann::json& j) {
+        int n = 0;
+        for (const auto& g : j["regions"]) {
+            if (g["kind"] != "plane") continue;
+            int zeros = 0;
+            for (const auto& c : g["params"]["normal"]) zeros += c.get<double>() == 0.0;
+            n += zeros != 2;
+        }
+        return n;
+    };
+    const CliRun snapped = run("segment " + stl.string() + " -o " + ply.string() + " --json -q");
+    ASSERT_EQ(snapped.code, 0) << snapped.err;
+    const auto js = nlohmann::json::parse(snapped.out);
+    EXPECT_GE(js["segment"]["snapped"].get<int>(), 2);
+    EXPECT_EQ(leaning_planes(js), 0);
+    const CliRun free =
+        run("segment " + stl.string() + " -o " + ply.string() + " --no-snap --json -q");
+    ASSERT_EQ(free.code, 0) << free.err;
+    const auto jf = nlohmann::json::parse(free.out);
+    EXPECT_EQ(jf["segment"]["snapped"].get<int>(), 0);
+    EXPECT_GE(leaning_planes(jf), 1);
+    EXPECT_EQ(jf["regions"].size(), js["regions"].size());
+}
+
 TEST(CliSegment, WritesRegionsLabelsAndOneJsonDocument) {
     const auto dir = test::scratch_dir() / "cli_segment";
     std::filesystem::remove_all(dir);

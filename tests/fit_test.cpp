@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -858,6 +859,7 @@ TEST(FitSnap, NearlyRoundValuesBecomeRoundAndTrueOnesStay) {
     ASSERT_TRUE(f.ok);
     SnapOptions o;
     o.tolerance = 0.1;
+    o.positions = false;  // FitSnap.PositionsAndOnlyWhatThePointsCannotTellApart
     std::vector<std::string> applied;
     const FitResult s = snap(f, in, o, &applied);
     ASSERT_TRUE(s.ok);
@@ -881,6 +883,54 @@ TEST(FitSnap, NearlyRoundValuesBecomeRoundAndTrueOnesStay) {
     applied.clear();
     const FitResult tool = snap(f, in, o, &applied);
     EXPECT_EQ(tool.surface.radius, 10.025);
+}
+
+// Float32 points of an exact bore (r 6.35, a quarter inch, along z through (12, -3.5)), a
+// plane (z = 40) and a sphere (r 12 about (1, 2, 140)), as a CAD tessellation gives them. The
+// fits are off by rounding; snapped, the values are exact. With the noise check, a loose tolerance
+// takes no value the points can tell from the fit (6.3 or 6.4); without it, it does.
+TEST(FitSnap, PositionsAndOnlyWhatThePointsCannotTellApart) {
+    test::Rng rng(23);
+    auto f32 = [](Vec3 p) {
+        return Vec3{static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
+    };
+    std::vector<Vec3> bore, bore_n, flat, flat_n, ball, ball_n;
+    for (int i = 0; i < 2000; ++i) {
+        const double a = 2 * kPi * rng.uniform(), b = kPi * (rng.uniform() - 0.5);
+        const Vec3 radial{std::cos(a), std::sin(a), 0};
+        bore.push_back(f32(Vec3{12, -3.5, 30 * rng.uniform()} + 6.35 * radial));
+        bore_n.push_back(-radial);
+        flat.push_back(f32(Vec3{50 * rng.uniform(), 30 * rng.uniform(), 40}));
+        flat_n.push_back({0, 0, 1});
+        const Vec3 dir{std::cos(b) * std::cos(a), std::cos(b) * std::sin(a), std::sin(b)};
+        ball.push_back(f32(Vec3{1, 2, 140} + 12 * dir));
+        ball_n.push_back(dir);
+    }
+    const FitInput bin{bore, bore_n, {}}, pin{flat, flat_n, {}}, sin{ball, ball_n, {}};
+    const FitResult fb = fit(FitKind::kCylinder, bin), fp = fit(FitKind::kPlane, pin),
+                    fs = fit(FitKind::kSphere, sin);
+    ASSERT_TRUE(fb.ok && fp.ok && fs.ok);
+    EXPECT_NE(fb.surface.radius, 6.35);  // rounding: the fit is close, not exact
+    SnapOptions o;
+    o.tolerance = 0.1;  // loose: 6.4 keeps every point within it
+    o.noise = 1e-6;     // float32 rounding of coordinates up to 140
+    o.rms_floor = 1e-6;
+    std::vector<std::string> applied;
+    const FitResult sb = snap(fb, bin, o, &applied);
+    EXPECT_EQ(std::fabs(sb.surface.axis.z), 1.0);
+    EXPECT_EQ(sb.surface.point.x, 12.0);
+    EXPECT_EQ(sb.surface.point.y, -3.5);
+    EXPECT_EQ(sb.surface.radius, 6.35);
+    EXPECT_NE(std::find(applied.begin(), applied.end(), "axis at x 12 y -3.5"), applied.end());
+    const FitResult sp = snap(fp, pin, o);
+    EXPECT_EQ(std::fabs(sp.surface.axis.z), 1.0);
+    EXPECT_EQ(sp.surface.point.z, 40.0);
+    const FitResult ss = snap(fs, sin, o);
+    EXPECT_EQ(ss.surface.point, (Vec3{1, 2, 140}));
+    EXPECT_EQ(ss.surface.radius, 12.0);
+    // The tolerance alone: 6.3 or 6.4 (whichever rounding reaches first) is within it.
+    o.noise = -1;
+    EXPECT_NEAR(std::fabs(snap(fb, bin, o).surface.radius - 6.35), 0.05, 1e-12);
 }
 
 TEST(FitSnap, CounterboreAndHoleBecomeCoaxialAndTheShoulderParallel) {
@@ -917,7 +967,9 @@ TEST(FitSnap, CounterboreAndHoleBecomeCoaxialAndTheShoulderParallel) {
     // Fitted apart, the three axes differ by noise.
     EXPECT_NE(fits[0].surface.axis, fits[1].surface.axis);
     const double tol = 0.01;
-    const std::vector<std::string> notes = snap_together(fits, inputs, tol);
+    SnapOptions o;
+    o.tolerance = tol;
+    const std::vector<std::string> notes = snap_together(fits, inputs, o);
     ASSERT_EQ(notes.size(), 2u);
     EXPECT_EQ(notes[0], "3 axes made parallel");
     EXPECT_EQ(notes[1], "2 surfaces made coaxial");
@@ -931,7 +983,8 @@ TEST(FitSnap, CounterboreAndHoleBecomeCoaxialAndTheShoulderParallel) {
     std::vector<FitResult> again = {fit(FitKind::kCylinder, inputs[0]),
                                     fit(FitKind::kCylinder, inputs[1]),
                                     fit(FitKind::kPlane, inputs[2])};
-    EXPECT_TRUE(snap_together(again, inputs, 0.001).empty());
+    o.tolerance = 0.001;
+    EXPECT_TRUE(snap_together(again, inputs, o).empty());
 }
 
 TEST(FitSnap, ConeAnglesAndTorusRadii) {

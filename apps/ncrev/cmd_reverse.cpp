@@ -21,6 +21,7 @@ struct ReverseCliOptions {
     double tolerance = 0;
     bool no_colors = false;
     bool no_surfaces = false;
+    bool no_snap = false;
     StepSchema schema = StepSchema::kAP214;
     bool require_solid = false;
     bool json = false;
@@ -67,6 +68,10 @@ void add_reverse(CLI::App& app, Context& ctx) {
         ->check(kPositive);
     cmd->add_flag("--no-surface-indices", o->no_surfaces,
                   "Segment every facet, ignoring the surface indices of an SRE file");
+    cmd->add_flag("--no-snap", o->no_snap,
+                  "Keep the fitted values: by default axes are made parallel, coaxial and along "
+                  "the coordinate axes, and positions, radii and cone angles round, where the "
+                  "points cannot tell them from the fit");
     cmd->add_flag("--no-colors", o->no_colors, "Write plain geometry, without face colors");
     const std::map<std::string, StepSchema> schemas{{"ap214", StepSchema::kAP214},
                                                     {"ap203", StepSchema::kAP203},
@@ -123,6 +128,7 @@ void add_reverse(CLI::App& app, Context& ctx) {
         ro.segment.tolerance = o->tolerance;
         ro.segment.surfaces = healed->surfaces;
         ro.segment.use_surface_indices = !o->no_surfaces;
+        ro.segment.snap = !o->no_snap;
         auto rev = reverse_to_step(healed->mesh, out, ro);
         if (!rev) {
             // A mesh with nothing to write is the input's fault: name the input.

@@ -18,6 +18,7 @@ struct SegmentCliOptions {
     SegmentOptions segment;
     double sharp_degrees = 0;
     bool no_surfaces = false;
+    bool no_snap = false;
     bool json = false;
     bool quiet = false;
 };
@@ -59,6 +60,10 @@ void add_segment(CLI::App& app, Context& ctx) {
         ->check(CLI::Range(1.0, 179.0));
     cmd->add_flag("--no-surface-indices", o->no_surfaces,
                   "Segment every facet, ignoring the surface indices of an SRE file");
+    cmd->add_flag("--no-snap", o->no_snap,
+                  "Keep the fitted values: by default axes are made parallel, coaxial and along "
+                  "the coordinate axes, and positions, radii and cone angles round, where the "
+                  "points cannot tell them from the fit");
     cmd->add_flag(
         "--json", o->json,
         "Print one JSON object on stdout: input, healing, mesh, segment (method, "
@@ -88,6 +93,7 @@ void add_segment(CLI::App& app, Context& ctx) {
         if (o->sharp_degrees > 0) so.sharp_angle = o->sharp_degrees * std::numbers::pi / 180;
         so.surfaces = healed->surfaces;
         so.use_surface_indices = !o->no_surfaces;
+        so.snap = !o->no_snap;
         const auto progress = terminal_progress(ctx, o->quiet);
         Result<SegmentResult> r = segment(healed->mesh, so, progress);
         if (!r) {

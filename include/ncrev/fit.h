@@ -241,8 +241,15 @@ constexpr FitKindSet kRevolutionFitKinds = (FitKindSet{1} << 5) - 1;
 KindSelection fit_simplest(const FitInput& input, double tolerance,
                            FitKindSet kinds = kAllFitKinds);
 
+/// SnapOptions::noise: the rise of the sum of squared residuals, in units of the noise variance,
+/// that holding parameters at their true values stays below: it is chi-square distributed with
+/// as many degrees of freedom as parameters held, up to 5 (a cylinder's axis, line and radius),
+/// whose 99.9 % quantile is 20.5.
+inline constexpr double kSnapChi2 = 20;
+
 /// What snap() may do. Every change is kept only when the refitted surface (the snapped values
-/// held, the other parameters fitted again) still keeps every point within `tolerance`.
+/// held, the other parameters fitted again) still keeps every point within `tolerance`, and,
+/// with `noise`, explains the points as well as the fit before snapping, within chance.
 struct SnapOptions {
     double tolerance = 0;  ///< max residual allowed after snapping, model units
     /// Axes and plane normals to the nearest coordinate axis when within 2 degrees.
@@ -250,9 +257,25 @@ struct SnapOptions {
     /// Radii to round values (multiples of 1, 0.5, 0.1, 0.05, 0.01 model units, coarsest
     /// first) and cone half-angles to multiples of 5, 1, 0.5 degrees.
     bool round_values = true;
+    /// Where an axis or a plane's normal is a coordinate axis (exactly, e.g. once snapped):
+    /// the axis line's place across it (cylinders, cones, tori), a torus's center along it, a
+    /// plane's offset; and a sphere's center; to round values, the radii's steps.
+    bool positions = true;
     /// Radii to try before round values, e.g. the radii of the tools of an SRE file
     /// (diameter / 2, corner radius): the nearest one that keeps the tolerance wins.
     std::vector<double> tool_radii;
+    /// When >= 0, the standard deviation of the points about their true surface (a mesh's
+    /// noise; rounding for a CAD tessellation): a change is also kept only when it raises the
+    /// mean square residual by at most kSnapChi2 x noise^2 / n (n points, or (sum of weights)^2
+    /// / sum of squared weights) plus rms_floor^2, i.e. when the held values lie within a few
+    /// standard errors of the fitted ones and the points cannot tell them apart. Without it (< 0)
+    /// the tolerance alone decides, and a loose tolerance takes round values that are not the
+    /// part's (6.35 -> 6.4).
+    double noise = -1;
+    double rms_floor = 0;  ///< model units; see noise
+    /// snap(): the RMS that `noise` compares with when >= 0 (the free fit's, for a fit already
+    /// snapped by snap_together()); otherwise the fit's own.
+    double base_rms = -1;
 };
 
 /// A fit with machined-part values: see SnapOptions. `applied` lists what was snapped, in
@@ -263,12 +286,17 @@ FitResult snap(const FitResult& fit, const FitInput& input, const SnapOptions& o
 
 /// Snaps surfaces to each other, as machined features are (method.md Step 4): axes (and plane
 /// normals) within 0.5 degree of each other become one direction, and cylinders, cones and
-/// tori whose axes are then within `tolerance` of each other share one axis line (coaxial
-/// bores, a counterbore and its hole, a turned shaft's steps). A group is snapped only when
-/// every member, refitted with the common axis held, keeps its points within `tolerance`.
-/// `fits[i]` was fitted to `inputs[i]`; fits that are not ok, spheres, B-splines and the
-/// sheared kinds are left alone. Returns what was done, in words.
+/// tori whose axes are then within `options.tolerance` of each other share one axis line
+/// (coaxial bores, a counterbore and its hole, a turned shaft's steps). Every member of a group
+/// is refitted with the common axis held and must keep its points within the tolerance (and
+/// with options.noise, the RMS as snap() asks, from `base_rms[i]` when given, else from its
+/// RMS on entry);
+/// members that do not are left out of the group, which is tried again without them while it
+/// has two. `fits[i]` was fitted to `inputs[i]`; fits that are not ok, spheres, B-splines and
+/// the sheared kinds are left alone; options other than the tolerance and the RMS ones are not
+/// used. Returns what was done, in words. Deterministic.
 std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<const FitInput> inputs,
-                                       double tolerance);
+                                       const SnapOptions& options,
+                                       std::span<const double> base_rms = {});
 
 }  // namespace ncrev

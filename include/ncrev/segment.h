@@ -67,6 +67,10 @@ struct SegmentOptions {
     bool use_surface_indices = true;
     /// Curvature for the paper method (its vertex types and high-curvature points).
     CurvatureOptions curvature;
+    /// The final surfaces with machined-part values (method.md Step 4): parallel and coaxial
+    /// axes, axes along coordinate axes, round positions, radii and cone angles, each only
+    /// where the points cannot tell it from the fitted value (SegmentResult::snapped).
+    bool snap = true;
 };
 
 /// One region: the facets that one surface describes.
@@ -100,6 +104,7 @@ struct SegmentResult {
     std::uint64_t merges = 0;             ///< region pairs merged
     std::uint64_t freeform_groups = 0;    ///< groups of pieces replaced by one B-spline
     std::uint64_t reassigned_facets = 0;  ///< border facets moved to a better-fitting region
+    std::uint64_t snapped = 0;            ///< regions whose surface was snapped (options.snap)
     double curvature_seconds = 0, segment_seconds = 0, fit_seconds = 0;
     /// Wall-clock seconds of each step, in order: "edges" (dihedral angles, sharp edges, the
     /// deflection estimate), "grow" (the facets method's regions; "curvature" for the paper's),

@@ -2864,7 +2864,10 @@ constexpr unsigned kPositionBits = (1u << 0) | (1u << 1);
 /// Axes closer than this are made parallel when the tolerance allows.
 constexpr double kParallelDegrees = 0.5;
 constexpr double kAxisSnapDegrees = 2.0;
-constexpr double kRadiusSteps[] = {1.0, 0.5, 0.1, 0.05, 0.01};
+/// Round values are multiples of 1 / n model units for these n (steps 1, 0.5, 0.1, 0.05, 0.01):
+/// round(x n) / n is the double nearest to the decimal (6.35), which round(x / 0.05) x 0.05 is
+/// not.
+constexpr double kRoundDivisions[] = {1, 2, 10, 20, 100};
 constexpr double kAngleStepsDegrees[] = {5.0, 1.0, 0.5};
 
 template <class Model>
@@ -2895,6 +2898,32 @@ FitResult refit_surface(const Surface& s, unsigned frozen, const FitInput& in) {
     return {};
 }
 
+/// Bits of a torus's center along its axis and of a sphere's center (see their residual()).
+constexpr unsigned kTorusAlongBit = 1u << 4;
+constexpr unsigned kSphereCenterBits = (1u << 0) | (1u << 1) | (1u << 2);
+
+/// Whether `r`, refitted with values held, explains the points of `in` as well as a fit of
+/// RMS `base_rms` does, within chance (SnapOptions::noise).
+bool explains(const FitResult& r, double base_rms, const FitInput& in, const SnapOptions& o) {
+    if (o.noise < 0) return true;
+    double sum = 0, sum2 = 0;
+    for (std::size_t i = 0; i < in.points.size(); ++i) {
+        const double w = weight(in, i);
+        sum += w;
+        sum2 += w * w;
+    }
+    const double n = sum2 > 0 ? sum * sum / sum2 : 1.0;
+    return r.rms * r.rms <=
+           base_rms * base_rms + kSnapChi2 * o.noise * o.noise / n + o.rms_floor * o.rms_floor;
+}
+
+/// The coordinate axis `d` is exactly (+-), or -1.
+int coordinate_axis(Vec3 d) {
+    for (int k = 0; k < 3; ++k)
+        if (std::fabs(d[k]) == 1.0 && d[(k + 1) % 3] == 0 && d[(k + 2) % 3] == 0) return k;
+    return -1;
+}
+
 }  // namespace
 
 FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
@@ -2905,19 +2934,26 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
     }
     FitResult cur = fit0;
     unsigned frozen = 0;
-    auto accept = [&](const FitResult& r) { return r.ok && r.max <= o.tolerance; };
+    const double base_rms = o.base_rms >= 0 ? o.base_rms : fit0.rms;
+    auto accept = [&](const FitResult& r) {
+        return r.ok && r.max <= o.tolerance && explains(r, base_rms, in, o);
+    };
     auto note = [&](const std::string& what) {
         if (applied) applied->push_back(what);
     };
     const FitKind kind = cur.surface.kind;
+    static const char* kNames[3] = {"x", "y", "z"};
     // 1. The axis (or a plane's normal) to a coordinate axis.
     if (o.axes && kind != FitKind::kSphere) {
-        static const char* kNames[3] = {"x", "y", "z"};
         for (int k = 0; k < 3; ++k) {
             Vec3 e{};
             e[k] = 1;
             const double c = dot(cur.surface.axis, e);
             if (std::fabs(c) < std::cos(kAxisSnapDegrees * kPi / 180)) continue;
+            if (coordinate_axis(cur.surface.axis) == k) {  // already: held as it is
+                frozen |= kDirBits;
+                break;
+            }
             Surface s = cur.surface;
             s.axis = c > 0 ? e : -e;
             const FitResult r = refit_surface(s, frozen | kDirBits, in);
@@ -2929,7 +2965,44 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
             break;
         }
     }
-    // 2. Radii: tool radii first, then round values. Bit of each radius in its model.
+    // 2. Positions to round values, coarsest step first: `coords` of the surface's point
+    // together (held by `bits`); a plane has nothing left to fit once its offset is held.
+    if (o.positions) {
+        auto round_point = [&](std::initializer_list<int> coords, unsigned bits, const char* what) {
+            for (const double n : kRoundDivisions) {
+                Surface s = cur.surface;
+                bool moved = false;
+                for (const int k : coords) {
+                    const double rounded = std::round(s.point[k] * n) / n;
+                    moved = moved || rounded != s.point[k];
+                    s.point[k] = rounded;
+                }
+                if (!moved) return;  // already round at this step, so at every finer one
+                const FitResult r = kind == FitKind::kPlane ? residuals(s, in)
+                                                            : refit_surface(s, frozen | bits, in);
+                if (accept(r)) {
+                    std::string at = what;
+                    for (const int k : coords)
+                        at += std::string(" ") + kNames[k] + " " + number(r.surface.point[k]);
+                    note(at);
+                    cur = r;
+                    frozen |= bits;
+                    return;
+                }
+            }
+        };
+        const int k = coordinate_axis(cur.surface.axis);
+        if (k >= 0 && kind != FitKind::kSphere) frozen |= kDirBits;  // exact: it stays
+        if (kind == FitKind::kSphere) {
+            round_point({0, 1, 2}, kSphereCenterBits, "center");
+        } else if (k >= 0 && kind == FitKind::kPlane) {
+            round_point({k}, 0, "offset");
+        } else if (k >= 0) {
+            round_point({(k + 1) % 3, (k + 2) % 3}, kPositionBits, "axis at");
+            if (kind == FitKind::kTorus) round_point({k}, kTorusAlongBit, "center at");
+        }
+    }
+    // 3. Radii: tool radii first, then round values. Bit of each radius in its model.
     struct RadiusSlot {
         double Surface::*field;
         unsigned bit;
@@ -2953,8 +3026,8 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
         for (double t : tools)
             if (t > 0) candidates.push_back(t);
         if (o.round_values) {
-            for (double step : kRadiusSteps) {
-                const double rounded = std::round(value / step) * step;
+            for (const double n : kRoundDivisions) {
+                const double rounded = std::round(value * n) / n;
                 if (rounded > 0) candidates.push_back(rounded);
             }
         }
@@ -2972,7 +3045,7 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
             }
         }
     }
-    // 3. A cone's half-angle to round degrees.
+    // 4. A cone's half-angle to round degrees.
     if (kind == FitKind::kCone && o.round_values) {
         const double deg = cur.surface.angle * 180 / kPi;
         for (double step : kAngleStepsDegrees) {
@@ -2993,9 +3066,13 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
 }
 
 std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<const FitInput> inputs,
-                                       double tolerance) {
+                                       const SnapOptions& o, std::span<const double> base_rms) {
     std::vector<std::string> notes;
-    if (fits.size() != inputs.size()) return notes;
+    if (fits.size() != inputs.size() || (!base_rms.empty() && base_rms.size() != fits.size()))
+        return notes;
+    std::vector<double> from(fits.size());
+    for (std::size_t i = 0; i < fits.size(); ++i)
+        from[i] = base_rms.empty() ? fits[i].rms : base_rms[i];
     auto has_axis = [&](std::size_t i) {
         const FitKind k = fits[i].surface.kind;
         return fits[i].ok && (k == FitKind::kPlane || k == FitKind::kCylinder ||
@@ -3004,17 +3081,35 @@ std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<cons
     auto is_revolution = [&](std::size_t i) {
         return has_axis(i) && fits[i].surface.kind != FitKind::kPlane;
     };
-    // Refits every member with `frozen` held at the surface `make(i)` gives; commits only
-    // when all keep the tolerance.
-    auto try_group = [&](const std::vector<std::size_t>& group, unsigned frozen, const auto& make) {
-        std::vector<FitResult> out;
-        for (const std::size_t i : group) {
-            FitResult r = refit_surface(make(i), frozen, inputs[i]);
-            if (!r.ok || r.max > tolerance) return false;
-            out.push_back(std::move(r));
+    // Refits every member with `frozen` held at the surface `make(group)` gives for it, and
+    // commits when all keep the tolerance (and the RMS); otherwise leaves out the members that
+    // do not and tries the rest again. A member `make` leaves as it was is not refitted.
+    // Returns the members committed (none, or at least two).
+    auto try_group = [&](std::vector<std::size_t> group, unsigned frozen, const auto& make) {
+        while (group.size() >= 2) {
+            std::vector<std::optional<Surface>> wanted = make(group);
+            std::vector<FitResult> out(group.size());
+            std::vector<std::uint8_t> bad(group.size(), 0);
+            tbb::parallel_for(std::size_t{0}, group.size(), [&](std::size_t k) {
+                const std::size_t i = group[k];
+                if (!wanted[k]) {
+                    out[k] = fits[i];
+                    return;
+                }
+                out[k] = refit_surface(*wanted[k], frozen, inputs[i]);
+                bad[k] = !out[k].ok || out[k].max > o.tolerance ||
+                         !explains(out[k], from[i], inputs[i], o);
+            });
+            if (std::find(bad.begin(), bad.end(), 1) == bad.end()) {
+                for (std::size_t k = 0; k < group.size(); ++k) fits[group[k]] = std::move(out[k]);
+                return group;
+            }
+            std::vector<std::size_t> kept;
+            for (std::size_t k = 0; k < group.size(); ++k)
+                if (!bad[k]) kept.push_back(group[k]);
+            group = std::move(kept);
         }
-        for (std::size_t k = 0; k < group.size(); ++k) fits[group[k]] = std::move(out[k]);
-        return true;
+        return std::vector<std::size_t>{};
     };
     const double cos_parallel = std::cos(kParallelDegrees * kPi / 180);
     // 1. Parallel directions: greedy groups around each unassigned axis, in order.
@@ -3035,19 +3130,35 @@ std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<cons
     for (const auto& g : groups) {
         if (g.size() < 2) continue;
         // The common direction: the point-count-weighted mean, signs aligned with the first.
-        Vec3 mean{};
-        for (const std::size_t i : g) {
-            const Vec3 a = fits[i].surface.axis;
-            mean += static_cast<double>(inputs[i].points.size()) *
-                    (dot(a, fits[g[0]].surface.axis) < 0 ? -a : a);
+        const auto parallel = [&](const std::vector<std::size_t>& group) {
+            Vec3 mean{};
+            for (const std::size_t i : group) {
+                const Vec3 a = fits[i].surface.axis;
+                mean += static_cast<double>(inputs[i].points.size()) *
+                        (dot(a, fits[group[0]].surface.axis) < 0 ? -a : a);
+            }
+            const Vec3 dir = normalized(mean);
+            std::vector<std::optional<Surface>> out;
+            for (const std::size_t i : group) {
+                Surface s = fits[i].surface;
+                const Vec3 want = dot(s.axis, dir) < 0 ? -dir : dir;
+                if (s.axis == want) {
+                    out.emplace_back();
+                } else {
+                    s.axis = want;
+                    out.emplace_back(s);
+                }
+            }
+            return out;
+        };
+        const Vec3 a0 = fits[g[0]].surface.axis;
+        if (std::all_of(g.begin(), g.end(), [&](std::size_t i) {
+                return fits[i].surface.axis == a0 || fits[i].surface.axis == -a0;
+            })) {
+            continue;  // parallel already
         }
-        const Vec3 dir = normalized(mean);
-        const bool ok = try_group(g, kDirBits, [&](std::size_t i) {
-            Surface s = fits[i].surface;
-            s.axis = dot(s.axis, dir) < 0 ? -dir : dir;
-            return s;
-        });
-        if (ok) notes.push_back(std::to_string(g.size()) + " axes made parallel");
+        const std::vector<std::size_t> done = try_group(g, kDirBits, parallel);
+        if (!done.empty()) notes.push_back(std::to_string(done.size()) + " axes made parallel");
     }
     // 2. Coaxial: surfaces of revolution whose axis lines (now parallel) nearly coincide.
     std::vector<bool> used(fits.size(), false);
@@ -3059,29 +3170,39 @@ std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<cons
             if (!is_revolution(j) || used[j]) continue;
             if (std::fabs(dot(d, fits[j].surface.axis)) < 1 - 1e-12) continue;
             const Vec3 w = fits[j].surface.point - fits[i].surface.point;
-            if (norm(w - dot(w, d) * d) <= tolerance) g.push_back(j);
+            if (norm(w - dot(w, d) * d) <= o.tolerance) g.push_back(j);
         }
         if (g.size() < 2) continue;
+        if (std::all_of(g.begin(), g.end(), [&](std::size_t k) {
+                const Vec3 w = fits[k].surface.point - fits[i].surface.point;
+                return w - dot(w, d) * d == Vec3{};
+            })) {
+            continue;  // on one line already
+        }
         // The common line: through the mean of the members' axis points, projected.
-        Vec3 mean{};
-        double total = 0;
-        for (const std::size_t k : g) {
-            const double wgt = static_cast<double>(inputs[k].points.size());
-            const Vec3 w = fits[k].surface.point - fits[i].surface.point;
-            mean += wgt * (w - dot(w, d) * d);
-            total += wgt;
-        }
-        const Vec3 base = fits[i].surface.point + mean / total;
-        const bool ok = try_group(g, kDirBits | kPositionBits, [&](std::size_t k) {
-            Surface s = fits[k].surface;
-            // Keep the member's own place along the axis.
-            s.point = base + dot(s.point - base, d) * d;
-            return s;
-        });
-        if (ok) {
-            for (const std::size_t k : g) used[k] = true;
-            notes.push_back(std::to_string(g.size()) + " surfaces made coaxial");
-        }
+        const auto coaxial = [&](const std::vector<std::size_t>& group) {
+            Vec3 mean{};
+            double total = 0;
+            const Vec3 p0 = fits[group[0]].surface.point;
+            for (const std::size_t k : group) {
+                const double wgt = static_cast<double>(inputs[k].points.size());
+                const Vec3 w = fits[k].surface.point - p0;
+                mean += wgt * (w - dot(w, d) * d);
+                total += wgt;
+            }
+            const Vec3 base = p0 + mean / total;
+            std::vector<std::optional<Surface>> out;
+            for (const std::size_t k : group) {
+                Surface s = fits[k].surface;
+                // Keep the member's own place along the axis.
+                s.point = base + dot(s.point - base, d) * d;
+                out.emplace_back(s);
+            }
+            return out;
+        };
+        const std::vector<std::size_t> done = try_group(g, kDirBits | kPositionBits, coaxial);
+        for (const std::size_t k : done) used[k] = true;
+        if (!done.empty()) notes.push_back(std::to_string(done.size()) + " surfaces made coaxial");
     }
     return notes;
 }

@@ -182,10 +182,13 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
     json& r = j["reverse"];
     if (rev.segmentation) {
         const SegmentResult& seg = *rev.segmentation;
-        r["segment"] = {
-            {"method", to_string(seg.method)},      {"tolerance", seg.tolerance},
-            {"tolerance_rule", seg.tolerance_rule}, {"chordal_deflection", seg.chordal_deflection},
-            {"given_facets", seg.given_facets},     {"steps", steps_json(seg)}};
+        r["segment"] = {{"method", to_string(seg.method)},
+                        {"tolerance", seg.tolerance},
+                        {"tolerance_rule", seg.tolerance_rule},
+                        {"chordal_deflection", seg.chordal_deflection},
+                        {"given_facets", seg.given_facets},
+                        {"snapped", seg.snapped},
+                        {"steps", steps_json(seg)}};
         r["regions"] = seg.regions.size();
         json fallbacks = json::array();
         for (const ReverseFallback& f : rev.fallbacks) {
@@ -344,6 +347,7 @@ std::string to_json(const InfoReport& info, const SegmentResult& r, int indent) 
                     {"merges", r.merges},
                     {"freeform_groups", r.freeform_groups},
                     {"reassigned_facets", r.reassigned_facets},
+                    {"snapped", r.snapped},
                     {"seconds",
                      {{"curvature", r.curvature_seconds},
                       {"segment", r.segment_seconds},
@@ -379,6 +383,9 @@ std::string to_text(const SegmentResult& r, Unit unit) {
     if (r.given_facets) s += std::to_string(r.given_facets) + " facets kept their SRE surface\n";
     if (outside)
         s += std::to_string(outside) + " regions not within the tolerance of any surface\n";
+    if (r.snapped)
+        s += std::to_string(r.snapped) +
+             " regions snapped to round values, parallel or coaxial axes\n";
     std::snprintf(buf, sizeof buf, "seconds: curvature %.3f, segment %.3f, fit %.3f\n",
                   r.curvature_seconds, r.segment_seconds, r.fit_seconds);
     s += buf;
