@@ -22,6 +22,7 @@
 #include "ncrev/sample.h"
 #include "sample_cases.h"
 #include "scratch.h"
+#include "test_meshes.h"
 
 namespace ncrev {
 namespace {
@@ -358,6 +359,36 @@ TEST(Segment, SnappedSurfacesHaveThePartsValues) {
             EXPECT_LT(exact_free, exact);
         }
     }
+}
+
+// A ball-end pocket's sphere of radius 3.175 (a quarter-inch tool), with noise of a tenth of the
+// tolerance: no round value in hundredths is within the noise of it (3.17 and 3.18 are 0.005 off,
+// the fit's standard error 3e-6), so the free fit stays; with the SRE's tool of diameter 6.35
+// its radius is exactly the tool's, and its center the round one.
+TEST(Segment, RadiiSnapToTheSreTools) {
+    test::Rng rng(5);
+    TriangleSoup soup = test::to_indexed_soup(test::icosphere(3.175, 4, {10, 20, 5}));
+    const double sigma = 0.1 * default_segment_tolerance(build_mesh(soup).value().mesh);
+    for (Vec3& p : soup.points) p += sigma * Vec3{rng.gaussian(), rng.gaussian(), rng.gaussian()};
+    const Mesh mesh = build_mesh(soup).value().mesh;
+    const SegmentResult plain = segment(mesh).value();
+    ASSERT_EQ(plain.regions.size(), 1u);
+    ASSERT_EQ(plain.regions[0].fit.surface.kind, FitKind::kSphere);
+    EXPECT_NE(plain.regions[0].fit.surface.radius, 3.175);
+    EXPECT_NEAR(plain.regions[0].fit.surface.radius, 3.175, 1e-4);
+    EXPECT_EQ(plain.regions[0].fit.surface.point, (Vec3{10, 20, 5}));
+    ToolRecord ball;
+    ball.kind = ToolKind::kBall;
+    ball.diameter = 6.35;
+    ball.corner_radius = 3.175;
+    const ToolRecord tools[] = {ball};
+    SegmentOptions o;
+    o.tools = tools;
+    const SegmentResult r = segment(mesh, o).value();
+    ASSERT_EQ(r.regions.size(), 1u);
+    EXPECT_EQ(r.regions[0].fit.surface.radius, 3.175);
+    EXPECT_EQ(r.regions[0].fit.surface.point, (Vec3{10, 20, 5}));
+    EXPECT_EQ(r.snapped, 1u);
 }
 
 TEST(Segment, LabelsFollowTheInputFacets) {

@@ -127,6 +127,7 @@ void add_reverse(CLI::App& app, Context& ctx) {
         ro.colors = !o->no_colors;
         ro.segment.tolerance = o->tolerance;
         ro.segment.surfaces = healed->surfaces;
+        ro.segment.tools = healed->tools;
         ro.segment.use_surface_indices = !o->no_surfaces;
         ro.segment.snap = !o->no_snap;
         auto rev = reverse_to_step(healed->mesh, out, ro);

@@ -92,6 +92,7 @@ void add_segment(CLI::App& app, Context& ctx) {
         SegmentOptions so = o->segment;
         if (o->sharp_degrees > 0) so.sharp_angle = o->sharp_degrees * std::numbers::pi / 180;
         so.surfaces = healed->surfaces;
+        so.tools = healed->tools;
         so.use_surface_indices = !o->no_surfaces;
         so.snap = !o->no_snap;
         const auto progress = terminal_progress(ctx, o->quiet);

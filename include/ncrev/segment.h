@@ -67,6 +67,9 @@ struct SegmentOptions {
     bool use_surface_indices = true;
     /// Curvature for the paper method (its vertex types and high-curvature points).
     CurvatureOptions curvature;
+    /// The SRE tools table (HealedMesh::tools): the radii snapping tries before round values,
+    /// each tool's diameter / 2 and corner radius.
+    std::span<const ToolRecord> tools;
     /// The final surfaces with machined-part values (method.md Step 4): parallel and coaxial
     /// axes, axes along coordinate axes, round positions, radii and cone angles, each only
     /// where the points cannot tell it from the fitted value (SegmentResult::snapped).

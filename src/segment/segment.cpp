@@ -3078,11 +3078,12 @@ bool same_surface(const Surface& a, const Surface& b) {
 /// lines (snap_together()), then axes along coordinate axes, round positions, radii and cone angles
 /// (snap()), each only while every vertex stays within the tolerance, the RMS as close to the free
 /// fit's as the mesh's `noise` allows (SnapOptions::noise), and the facets chords of the surface.
-/// Regions given by SRE and loose ones (held to chords) are left as they are. Returns the regions
+/// Radii try the SRE `tools`' radii first. Regions given by SRE and loose ones (held to chords)
+/// are left as they are. Returns the regions
 /// whose surface changed.
 std::uint64_t snap_regions(Context& c, const std::vector<Draft>& drafts,
                            std::span<const std::uint32_t> order, std::vector<Region>& fitted,
-                           double noise) {
+                           double noise, std::span<const ToolRecord> tools) {
     std::vector<std::uint32_t> which;
     for (const std::uint32_t r : order) {
         const Region& g = fitted[r];
@@ -3109,6 +3110,10 @@ std::uint64_t snap_regions(Context& c, const std::vector<Draft>& drafts,
     o.tolerance = c.tol;
     o.noise = noise;
     o.rms_floor = kSnapRmsFloor * c.tol;
+    for (const ToolRecord& t : tools) {
+        o.tool_radii.push_back(t.diameter / 2);
+        if (t.corner_radius > 0) o.tool_radii.push_back(t.corner_radius);
+    }
     snap_together(fits, inputs, o, free_rms);
     std::vector<std::uint8_t> changed(n, 0);
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
@@ -3125,12 +3130,11 @@ std::uint64_t snap_regions(Context& c, const std::vector<Draft>& drafts,
 }
 
 /// Regions numbered in the order of their first face; faces labelled; final fits, snapped with
-/// `snap` (snap_regions()). With `loose`, free-form faces in loose pieces are merged on the way
-/// (merge_loose_pieces()).
-/// Returns the noise (noise_level()) of the regions before that: a free-form face merged from
-/// noisy pieces would hide it.
+/// `snap` (snap_regions(), with the SRE `tools`). With `loose`, free-form faces in loose pieces are
+/// merged on the way (merge_loose_pieces()). Returns the noise (noise_level()) of the regions
+/// before that: a free-form face merged from noisy pieces would hide it.
 double finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRecord> records,
-              SegmentResult& result, bool loose, bool snap) {
+              SegmentResult& result, bool loose, bool snap, std::span<const ToolRecord> tools) {
     std::vector<std::uint32_t> order = live_drafts(drafts);
     std::vector<Region> fitted(drafts.size());
     tbb::parallel_for(std::size_t{0}, order.size(), [&](std::size_t i) {
@@ -3167,7 +3171,7 @@ double finish(Context& c, std::vector<Draft>& drafts, std::span<const SurfaceRec
         });
         if (!merged.empty()) order = live_drafts(drafts);
     }
-    result.snapped = snap ? snap_regions(c, drafts, order, fitted, noise) : 0;
+    result.snapped = snap ? snap_regions(c, drafts, order, fitted, noise, tools) : 0;
     result.region = FaceMap<std::int32_t>(c.m.num_faces(), -1);
     result.regions.resize(order.size());
     for (std::size_t i = 0; i < order.size(); ++i) {
@@ -3371,7 +3375,7 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
     if (progress) progress("segment", 1.0);
     if (progress) progress("fit", 0.0);
     noise = finish(c, drafts, options.surfaces, result, options.method == SegmentMethod::kFacets,
-                   options.snap);
+                   options.snap, options.tools);
     result.fit_seconds = step_done("fit");
     if (progress) progress("fit", 1.0);
     return result;
