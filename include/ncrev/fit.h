@@ -268,9 +268,10 @@ struct SnapOptions {
     /// noise; rounding for a CAD tessellation): a change is also kept only when it raises the
     /// mean square residual by at most kSnapChi2 x noise^2 / n (n points, or (sum of weights)^2
     /// / sum of squared weights) plus rms_floor^2, i.e. when the held values lie within a few
-    /// standard errors of the fitted ones and the points cannot tell them apart. Without it (< 0)
-    /// the tolerance alone decides, and a loose tolerance takes round values that are not the
-    /// part's (6.35 -> 6.4).
+    /// standard errors of the fitted ones and the points cannot tell them apart. A fit whose own
+    /// residuals show less noise (RMS^2 n / (n - p) for p parameters, n > p + 1) is held to that.
+    /// Without it (< 0) the tolerance alone decides, and a loose tolerance takes round values that
+    /// are not the part's (6.35 -> 6.4).
     double noise = -1;
     double rms_floor = 0;  ///< model units; see noise
     /// snap(): the RMS that `noise` compares with when >= 0 (the free fit's, for a fit already

@@ -2913,8 +2913,15 @@ bool explains(const FitResult& r, double base_rms, const FitInput& in, const Sna
         sum2 += w * w;
     }
     const double n = sum2 > 0 ? sum * sum / sum2 : 1.0;
+    // A fit whose own residuals show less than the noise (an exact face of a CAD mesh among
+    // approximate ones) is held to them: their variance estimate, RMS^2 n / (n - p).
+    static constexpr int kParameters[] = {3, 4, 5, 6, 7};  // plane, sphere, cylinder, cone, torus
+    const auto kind = static_cast<std::size_t>(r.surface.kind);
+    const double p = kind < std::size(kParameters) ? kParameters[kind] : 0;
+    double noise = o.noise;
+    if (n > p + 1) noise = std::min(noise, base_rms * std::sqrt(n / (n - p)));
     return r.rms * r.rms <=
-           base_rms * base_rms + kSnapChi2 * o.noise * o.noise / n + o.rms_floor * o.rms_floor;
+           base_rms * base_rms + kSnapChi2 * noise * noise / n + o.rms_floor * o.rms_floor;
 }
 
 /// The coordinate axis `d` is exactly (+-), or -1.
