@@ -987,6 +987,54 @@ TEST(FitSnap, CounterboreAndHoleBecomeCoaxialAndTheShoulderParallel) {
     EXPECT_TRUE(snap_together(again, inputs, o).empty());
 }
 
+// A hole (r 5) and its counterbore (r 8) along z through (3.14159, 2.71828), a place no round
+// value reaches, with noise: snap_together() makes them coaxial along z, and snap(), holding
+// what it fixed, rounds the radii without moving either off the shared line.
+TEST(FitSnap, CoaxialLinesStaySharedThroughSnap) {
+    test::Rng rng(52);
+    const Vec3 axis{0, 0, 1};
+    const Vec3 u = normalized(cross(axis, Vec3{1, 0, 0})), v = cross(axis, u);
+    const Vec3 origin{3.14159, 2.71828, 0};
+    std::vector<Vec3> hole, hole_n, bore, bore_n;
+    for (int i = 0; i < 3000; ++i) {
+        const double a = 2 * kPi * rng.uniform();
+        const Vec3 radial = std::cos(a) * u + std::sin(a) * v;
+        auto jitter = [&] {
+            return Vec3{0.001 * rng.gaussian(), 0.001 * rng.gaussian(), 0.001 * rng.gaussian()};
+        };
+        hole.push_back(origin + 5 * radial + 10 * rng.uniform() * axis + jitter());
+        hole_n.push_back(-radial);
+        bore.push_back(origin + 8 * radial + (10 + 4 * rng.uniform()) * axis + jitter());
+        bore_n.push_back(-radial);
+    }
+    const std::vector<FitInput> inputs = {{hole, hole_n, {}}, {bore, bore_n, {}}};
+    std::vector<FitResult> fits = {fit(FitKind::kCylinder, inputs[0]),
+                                   fit(FitKind::kCylinder, inputs[1])};
+    ASSERT_TRUE(fits[0].ok && fits[1].ok);
+    const std::vector<double> free_rms = {fits[0].rms, fits[1].rms};
+    SnapOptions o;
+    o.tolerance = 0.02;
+    o.noise = 0.001;
+    std::vector<SnapHold> holds;
+    const std::vector<std::string> notes = snap_together(fits, inputs, o, free_rms, &holds);
+    ASSERT_GE(notes.size(), 2u);
+    ASSERT_TRUE(holds[0].direction && holds[0].line && holds[1].direction && holds[1].line);
+    for (int i = 0; i < 2; ++i) {
+        SnapOptions own = o;
+        own.base_rms = free_rms[static_cast<std::size_t>(i)];
+        own.hold = holds[static_cast<std::size_t>(i)];
+        fits[static_cast<std::size_t>(i)] =
+            snap(fits[static_cast<std::size_t>(i)], inputs[static_cast<std::size_t>(i)], own);
+    }
+    EXPECT_EQ(fits[0].surface.radius, 5.0);
+    EXPECT_EQ(fits[1].surface.radius, 8.0);
+    EXPECT_EQ(std::fabs(fits[0].surface.axis.z), 1.0);
+    EXPECT_EQ(fits[0].surface.axis, fits[1].surface.axis);
+    EXPECT_EQ(fits[0].surface.point.x, fits[1].surface.point.x);
+    EXPECT_EQ(fits[0].surface.point.y, fits[1].surface.point.y);
+    EXPECT_NEAR(fits[0].surface.point.x, 3.14159, 1e-3);
+}
+
 TEST(FitSnap, ConeAnglesAndTorusRadii) {
     test::Rng rng(22);
     Patch cone = cone_patch(rng, 10, 29.999, 180, 10, 4000);

@@ -243,9 +243,22 @@ KindSelection fit_simplest(const FitInput& input, double tolerance,
 
 /// SnapOptions::noise: the rise of the sum of squared residuals, in units of the noise variance,
 /// that holding parameters at their true values stays below: it is chi-square distributed with
-/// as many degrees of freedom as parameters held, up to 5 (a cylinder's axis, line and radius),
-/// whose 99.9 % quantile is 20.5.
-inline constexpr double kSnapChi2 = 20;
+/// as many degrees of freedom as parameters held, up to 7 (a torus's axis, line, center along it
+/// and radii), whose 99.9 % quantile is 24.3. Every change is measured from the free fit, so
+/// the test is on all the values held so far.
+inline constexpr double kSnapChi2 = 24;
+
+/// What snap_together() fixed of a fit, for snap() to hold: its axis direction (shared with
+/// the parallel ones of its group, along a coordinate axis where the group's is), and its axis
+/// line (shared with coaxial surfaces, at round values where the group's is).
+struct SnapHold {
+    bool direction = false;
+    bool line = false;
+};
+
+/// The number of parameters of a kind's model: plane 3, sphere 4, cylinder 5, cone 6, torus 7;
+/// 0 for the others.
+int fit_parameters(FitKind kind);
 
 /// What snap() may do. Every change is kept only when the refitted surface (the snapped values
 /// held, the other parameters fitted again) still keeps every point within `tolerance`, and,
@@ -277,6 +290,9 @@ struct SnapOptions {
     /// snap(): the RMS that `noise` compares with when >= 0 (the free fit's, for a fit already
     /// snapped by snap_together()); otherwise the fit's own.
     double base_rms = -1;
+    /// snap(): what snap_together() fixed (its `holds`): held as it is, neither turned to a
+    /// coordinate axis nor moved to round values here (snap_together() did that for the group).
+    SnapHold hold;
 };
 
 /// A fit with machined-part values: see SnapOptions. `applied` lists what was snapped, in
@@ -289,15 +305,18 @@ FitResult snap(const FitResult& fit, const FitInput& input, const SnapOptions& o
 /// normals) within 0.5 degree of each other become one direction, and cylinders, cones and
 /// tori whose axes are then within `options.tolerance` of each other share one axis line
 /// (coaxial bores, a counterbore and its hole, a turned shaft's steps). Every member of a group
-/// is refitted with the common axis held and must keep its points within the tolerance (and
+/// is refitted with the common axis held and must keep its points within the tolerance (and,
 /// with options.noise, the RMS as snap() asks, from `base_rms[i]` when given, else from its
-/// RMS on entry);
-/// members that do not are left out of the group, which is tried again without them while it
-/// has two. `fits[i]` was fitted to `inputs[i]`; fits that are not ok, spheres, B-splines and
-/// the sheared kinds are left alone; options other than the tolerance and the RMS ones are not
-/// used. Returns what was done, in words. Deterministic.
+/// RMS on entry); members that do not are left out of the group, which is tried again without
+/// them while it has two. Then, with options.axes, a group's direction goes to a coordinate
+/// axis within 2 degrees, and with options.positions a coaxial group's line to round values
+/// across it, as snap() does for one surface; each for all members or none. `holds` (when not
+/// null) receives what each fit now shares, for snap() (SnapOptions::hold). `fits[i]` was
+/// fitted to `inputs[i]`; fits that are not ok, spheres, B-splines and the sheared kinds are
+/// left alone. Returns what was done, in words. Deterministic.
 std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<const FitInput> inputs,
                                        const SnapOptions& options,
-                                       std::span<const double> base_rms = {});
+                                       std::span<const double> base_rms = {},
+                                       std::vector<SnapHold>* holds = nullptr);
 
 }  // namespace ncrev

@@ -2915,9 +2915,7 @@ bool explains(const FitResult& r, double base_rms, const FitInput& in, const Sna
     const double n = sum2 > 0 ? sum * sum / sum2 : 1.0;
     // A fit whose own residuals show less than the noise (an exact face of a CAD mesh among
     // approximate ones) is held to them: their variance estimate, RMS^2 n / (n - p).
-    static constexpr int kParameters[] = {3, 4, 5, 6, 7};  // plane, sphere, cylinder, cone, torus
-    const auto kind = static_cast<std::size_t>(r.surface.kind);
-    const double p = kind < std::size(kParameters) ? kParameters[kind] : 0;
+    const double p = fit_parameters(r.surface.kind);
     double noise = o.noise;
     if (n > p + 1) noise = std::min(noise, base_rms * std::sqrt(n / (n - p)));
     return r.rms * r.rms <=
@@ -2932,6 +2930,23 @@ int coordinate_axis(Vec3 d) {
 }
 
 }  // namespace
+
+int fit_parameters(FitKind kind) {
+    switch (kind) {
+        case FitKind::kPlane:
+            return 3;
+        case FitKind::kSphere:
+            return 4;
+        case FitKind::kCylinder:
+            return CylinderModel::N;
+        case FitKind::kCone:
+            return ConeModel::N;
+        case FitKind::kTorus:
+            return TorusModel::N;
+        default:
+            return 0;
+    }
+}
 
 FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
                std::vector<std::string>* applied) {
@@ -2950,8 +2965,11 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
     };
     const FitKind kind = cur.surface.kind;
     static const char* kNames[3] = {"x", "y", "z"};
+    // What snap_together() fixed stays as it is.
+    if (kind != FitKind::kSphere && o.hold.direction) frozen |= kDirBits;
+    if (kind != FitKind::kSphere && kind != FitKind::kPlane && o.hold.line) frozen |= kPositionBits;
     // 1. The axis (or a plane's normal) to a coordinate axis.
-    if (o.axes && kind != FitKind::kSphere) {
+    if (o.axes && kind != FitKind::kSphere && !o.hold.direction) {
         for (int k = 0; k < 3; ++k) {
             Vec3 e{};
             e[k] = 1;
@@ -2984,7 +3002,10 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
                     moved = moved || rounded != s.point[k];
                     s.point[k] = rounded;
                 }
-                if (!moved) return;  // already round at this step, so at every finer one
+                if (!moved) {  // already round at this step, so at every finer one: held
+                    frozen |= bits;
+                    return;
+                }
                 const FitResult r = kind == FitKind::kPlane ? residuals(s, in)
                                                             : refit_surface(s, frozen | bits, in);
                 if (accept(r)) {
@@ -3005,7 +3026,7 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
         } else if (k >= 0 && kind == FitKind::kPlane) {
             round_point({k}, 0, "offset");
         } else if (k >= 0) {
-            round_point({(k + 1) % 3, (k + 2) % 3}, kPositionBits, "axis at");
+            if (!o.hold.line) round_point({(k + 1) % 3, (k + 2) % 3}, kPositionBits, "axis at");
             if (kind == FitKind::kTorus) round_point({k}, kTorusAlongBit, "center at");
         }
     }
@@ -3039,7 +3060,10 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
             }
         }
         for (double cand : candidates) {
-            if (cand == value) break;  // already round
+            if (cand == value) {  // already round: held
+                frozen |= slot.bit;
+                break;
+            }
             Surface s = cur.surface;
             s.*(slot.field) = sign * cand;
             const FitResult r = refit_surface(s, frozen | slot.bit, in);
@@ -3073,8 +3097,10 @@ FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,
 }
 
 std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<const FitInput> inputs,
-                                       const SnapOptions& o, std::span<const double> base_rms) {
+                                       const SnapOptions& o, std::span<const double> base_rms,
+                                       std::vector<SnapHold>* holds) {
     std::vector<std::string> notes;
+    if (holds) holds->assign(fits.size(), SnapHold{});
     if (fits.size() != inputs.size() || (!base_rms.empty() && base_rms.size() != fits.size()))
         return notes;
     std::vector<double> from(fits.size());
@@ -3088,11 +3114,12 @@ std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<cons
     auto is_revolution = [&](std::size_t i) {
         return has_axis(i) && fits[i].surface.kind != FitKind::kPlane;
     };
-    // Refits every member with `frozen` held at the surface `make(group)` gives for it, and
-    // commits when all keep the tolerance (and the RMS); otherwise leaves out the members that
-    // do not and tries the rest again. A member `make` leaves as it was is not refitted.
-    // Returns the members committed (none, or at least two).
-    auto try_group = [&](std::vector<std::size_t> group, unsigned frozen, const auto& make) {
+    // Refits every member with `frozen` held at the surface `make(group)` gives for it (none:
+    // left as it is), and commits when all keep the tolerance (and the RMS). Otherwise, unless
+    // `all`, leaves out the members that do not and tries the rest again. Returns the members
+    // committed (none, or at least two).
+    auto try_group = [&](std::vector<std::size_t> group, unsigned frozen, const auto& make,
+                         bool all) {
         while (group.size() >= 2) {
             std::vector<std::optional<Surface>> wanted = make(group);
             std::vector<FitResult> out(group.size());
@@ -3103,7 +3130,10 @@ std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<cons
                     out[k] = fits[i];
                     return;
                 }
-                out[k] = refit_surface(*wanted[k], frozen, inputs[i]);
+                // A plane has nothing to refit once its normal and offset are held.
+                out[k] = fits[i].surface.kind == FitKind::kPlane && (frozen & kPositionBits)
+                             ? residuals(*wanted[k], inputs[i])
+                             : refit_surface(*wanted[k], frozen, inputs[i]);
                 bad[k] = !out[k].ok || out[k].max > o.tolerance ||
                          !explains(out[k], from[i], inputs[i], o);
             });
@@ -3111,12 +3141,17 @@ std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<cons
                 for (std::size_t k = 0; k < group.size(); ++k) fits[group[k]] = std::move(out[k]);
                 return group;
             }
+            if (all) break;
             std::vector<std::size_t> kept;
             for (std::size_t k = 0; k < group.size(); ++k)
                 if (!bad[k]) kept.push_back(group[k]);
             group = std::move(kept);
         }
         return std::vector<std::size_t>{};
+    };
+    auto axis_dir = [&](std::size_t i, Vec3 like) {
+        const Vec3 a = fits[i].surface.axis;
+        return dot(a, like) < 0 ? -a : a;
     };
     const double cos_parallel = std::cos(kParallelDegrees * kPi / 180);
     // 1. Parallel directions: greedy groups around each unassigned axis, in order.
@@ -3136,36 +3171,58 @@ std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<cons
     }
     for (const auto& g : groups) {
         if (g.size() < 2) continue;
-        // The common direction: the point-count-weighted mean, signs aligned with the first.
-        const auto parallel = [&](const std::vector<std::size_t>& group) {
-            Vec3 mean{};
-            for (const std::size_t i : group) {
-                const Vec3 a = fits[i].surface.axis;
-                mean += static_cast<double>(inputs[i].points.size()) *
-                        (dot(a, fits[group[0]].surface.axis) < 0 ? -a : a);
-            }
-            const Vec3 dir = normalized(mean);
-            std::vector<std::optional<Surface>> out;
-            for (const std::size_t i : group) {
-                Surface s = fits[i].surface;
-                const Vec3 want = dot(s.axis, dir) < 0 ? -dir : dir;
-                if (s.axis == want) {
-                    out.emplace_back();
-                } else {
-                    s.axis = want;
-                    out.emplace_back(s);
-                }
-            }
-            return out;
-        };
         const Vec3 a0 = fits[g[0]].surface.axis;
-        if (std::all_of(g.begin(), g.end(), [&](std::size_t i) {
+        std::vector<std::size_t> done = g;
+        if (!std::all_of(g.begin(), g.end(), [&](std::size_t i) {
                 return fits[i].surface.axis == a0 || fits[i].surface.axis == -a0;
             })) {
-            continue;  // parallel already
+            // The common direction: the point-count-weighted mean, signs aligned with the first.
+            const auto parallel = [&](const std::vector<std::size_t>& group) {
+                Vec3 mean{};
+                for (const std::size_t i : group)
+                    mean += static_cast<double>(inputs[i].points.size()) *
+                            axis_dir(i, fits[group[0]].surface.axis);
+                const Vec3 dir = normalized(mean);
+                std::vector<std::optional<Surface>> out;
+                for (const std::size_t i : group) {
+                    Surface s = fits[i].surface;
+                    s.axis = axis_dir(i, dir) == fits[i].surface.axis ? dir : -dir;
+                    if (s.axis == fits[i].surface.axis) {
+                        out.emplace_back();
+                    } else {
+                        out.emplace_back(s);
+                    }
+                }
+                return out;
+            };
+            done = try_group(g, kDirBits, parallel, false);
+            if (done.empty()) continue;
+            notes.push_back(std::to_string(done.size()) + " axes made parallel");
         }
-        const std::vector<std::size_t> done = try_group(g, kDirBits, parallel);
-        if (!done.empty()) notes.push_back(std::to_string(done.size()) + " axes made parallel");
+        // The group's direction to a coordinate axis, for all or none.
+        const Vec3 d = fits[done[0]].surface.axis;
+        for (int k = 0; k < 3 && o.axes; ++k) {
+            if (std::fabs(d[k]) < std::cos(kAxisSnapDegrees * kPi / 180)) continue;
+            if (coordinate_axis(d) == k) break;
+            Vec3 e{};
+            e[k] = 1;
+            const auto to_axis = [&](const std::vector<std::size_t>& group) {
+                std::vector<std::optional<Surface>> out;
+                for (const std::size_t i : group) {
+                    Surface s = fits[i].surface;
+                    s.axis = dot(s.axis, e) < 0 ? -e : e;
+                    out.emplace_back(s);
+                }
+                return out;
+            };
+            if (!try_group(done, kDirBits, to_axis, true).empty()) {
+                static const char* kNames[3] = {"x", "y", "z"};
+                notes.push_back(std::to_string(done.size()) + " parallel axes to " + kNames[k]);
+            }
+            break;
+        }
+        if (holds)
+            for (const std::size_t i : done) (*holds)[i].direction = true;
     }
     // 2. Coaxial: surfaces of revolution whose axis lines (now parallel) nearly coincide.
     std::vector<bool> used(fits.size(), false);
@@ -3180,36 +3237,64 @@ std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<cons
             if (norm(w - dot(w, d) * d) <= o.tolerance) g.push_back(j);
         }
         if (g.size() < 2) continue;
-        if (std::all_of(g.begin(), g.end(), [&](std::size_t k) {
+        std::vector<std::size_t> done = g;
+        if (!std::all_of(g.begin(), g.end(), [&](std::size_t k) {
                 const Vec3 w = fits[k].surface.point - fits[i].surface.point;
                 return w - dot(w, d) * d == Vec3{};
             })) {
-            continue;  // on one line already
+            // The common line: through the mean of the members' axis points, projected.
+            const auto coaxial = [&](const std::vector<std::size_t>& group) {
+                Vec3 mean{};
+                double total = 0;
+                const Vec3 p0 = fits[group[0]].surface.point;
+                for (const std::size_t k : group) {
+                    const double wgt = static_cast<double>(inputs[k].points.size());
+                    const Vec3 w = fits[k].surface.point - p0;
+                    mean += wgt * (w - dot(w, d) * d);
+                    total += wgt;
+                }
+                const Vec3 base = p0 + mean / total;
+                std::vector<std::optional<Surface>> out;
+                for (const std::size_t k : group) {
+                    Surface s = fits[k].surface;
+                    // Keep the member's own place along the axis.
+                    s.point = base + dot(s.point - base, d) * d;
+                    out.emplace_back(s);
+                }
+                return out;
+            };
+            done = try_group(g, kDirBits | kPositionBits, coaxial, false);
+            if (done.empty()) continue;
+            notes.push_back(std::to_string(done.size()) + " surfaces made coaxial");
         }
-        // The common line: through the mean of the members' axis points, projected.
-        const auto coaxial = [&](const std::vector<std::size_t>& group) {
-            Vec3 mean{};
-            double total = 0;
-            const Vec3 p0 = fits[group[0]].surface.point;
-            for (const std::size_t k : group) {
-                const double wgt = static_cast<double>(inputs[k].points.size());
-                const Vec3 w = fits[k].surface.point - p0;
-                mean += wgt * (w - dot(w, d) * d);
-                total += wgt;
-            }
-            const Vec3 base = p0 + mean / total;
-            std::vector<std::optional<Surface>> out;
-            for (const std::size_t k : group) {
-                Surface s = fits[k].surface;
-                // Keep the member's own place along the axis.
-                s.point = base + dot(s.point - base, d) * d;
-                out.emplace_back(s);
-            }
-            return out;
-        };
-        const std::vector<std::size_t> done = try_group(g, kDirBits | kPositionBits, coaxial);
         for (const std::size_t k : done) used[k] = true;
-        if (!done.empty()) notes.push_back(std::to_string(done.size()) + " surfaces made coaxial");
+        // The line across a coordinate axis to round values, coarsest step first, all or none.
+        const int k = coordinate_axis(fits[done[0]].surface.axis);
+        if (o.positions && k >= 0) {
+            const int c1 = (k + 1) % 3, c2 = (k + 2) % 3;
+            const Vec3 p0 = fits[done[0]].surface.point;
+            for (const double n : kRoundDivisions) {
+                const double x1 = std::round(p0[c1] * n) / n, x2 = std::round(p0[c2] * n) / n;
+                if (x1 == p0[c1] && x2 == p0[c2]) break;
+                const auto rounded = [&](const std::vector<std::size_t>& group) {
+                    std::vector<std::optional<Surface>> out;
+                    for (const std::size_t m : group) {
+                        Surface s = fits[m].surface;
+                        s.point[c1] = x1;
+                        s.point[c2] = x2;
+                        out.emplace_back(s);
+                    }
+                    return out;
+                };
+                if (!try_group(done, kDirBits | kPositionBits, rounded, true).empty()) {
+                    notes.push_back(std::to_string(done.size()) + " coaxial lines at " +
+                                    number(x1) + " " + number(x2));
+                    break;
+                }
+            }
+        }
+        if (holds)
+            for (const std::size_t m : done) (*holds)[m] = {true, true};
     }
     return notes;
 }

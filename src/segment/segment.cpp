@@ -3103,31 +3103,47 @@ std::uint64_t snap_regions(Context& c, const std::vector<Draft>& drafts,
                            std::span<const std::uint32_t> order, std::vector<Region>& fitted,
                            std::span<const ToolRecord> tools) {
     std::vector<std::uint32_t> which;
-    std::vector<double> rms;
     for (const std::uint32_t r : order) {
         const Region& g = fitted[r];
         const Draft& d = drafts[r];
         if (d.surface_index >= 0 || d.loose > 0 || !g.fit.ok || !g.within_tolerance) continue;
         if (!(fit_kind_bit(g.fit.surface.kind) & kRevolutionFitKinds)) continue;
         which.push_back(r);
-        rms.push_back(g.fit.rms);
     }
-    if (which.empty()) return 0;
-    // The noise: the median region's RMS. The largest region's (noise_level()) may be a misfit:
-    // on the sample shallow_freeform a torus piece of the free-form face, 0.0036 mm, by which a
-    // cylinder piece of radius 3924 went from 0.0004 to 0.0057 mm RMS; its planes are exact.
-    std::nth_element(rms.begin(), rms.begin() + static_cast<std::ptrdiff_t>(rms.size() / 2),
-                     rms.end());
-    const double noise = rms[rms.size() / 2];
-    const double floor = kSnapRmsFloor * coordinate_rounding(c.m);
-    std::erase_if(which, [&](std::uint32_t r) {
-        return fitted[r].fit.rms > kSnapFitNoise * (noise + floor);
-    });
-    const std::size_t n = which.size();
-    std::vector<PointSet> sets(n);
-    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+    std::vector<PointSet> sets(which.size());
+    tbb::parallel_for(std::size_t{0}, which.size(), [&](std::size_t i) {
         c.gatherers.local().gather(c.m, c.fd, drafts[which[i]].faces, sets[i]);
     });
+    // The noise: the median of the regions' own estimates, RMS^2 n / (n - p) for n vertices and
+    // p parameters (unbiased: a 2-facet plane's RMS is half the noise). The largest region's RMS
+    // (noise_level()) may be a misfit: on the sample shallow_freeform a torus piece of the
+    // free-form face, 0.0036 mm, by which a cylinder piece of radius 3924 went from 0.0004 to
+    // 0.0057 mm RMS; its planes are exact.
+    std::vector<double> estimates;
+    for (std::size_t i = 0; i < which.size(); ++i) {
+        const double nv = static_cast<double>(sets[i].points.size());
+        const double p = fit_parameters(fitted[which[i]].fit.surface.kind);
+        if (nv > p + 1) estimates.push_back(fitted[which[i]].fit.rms * std::sqrt(nv / (nv - p)));
+    }
+    double noise = 0;
+    if (!estimates.empty()) {
+        std::nth_element(estimates.begin(),
+                         estimates.begin() + static_cast<std::ptrdiff_t>(estimates.size() / 2),
+                         estimates.end());
+        noise = estimates[estimates.size() / 2];
+    }
+    const double floor = kSnapRmsFloor * coordinate_rounding(c.m);
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < which.size(); ++i) {
+        if (fitted[which[i]].fit.rms > kSnapFitNoise * (noise + floor)) continue;
+        if (n != i) {
+            which[n] = which[i];
+            sets[n] = std::move(sets[i]);
+        }
+        ++n;
+    }
+    which.resize(n);
+    sets.resize(n);
     std::vector<FitResult> fits(n);
     std::vector<FitInput> inputs(n);
     std::vector<double> free_rms(n);
@@ -3144,17 +3160,24 @@ std::uint64_t snap_regions(Context& c, const std::vector<Draft>& drafts,
         o.tool_radii.push_back(t.diameter / 2);
         if (t.corner_radius > 0) o.tool_radii.push_back(t.corner_radius);
     }
-    snap_together(fits, inputs, o, free_rms);
+    std::vector<SnapHold> holds;
+    snap_together(fits, inputs, o, free_rms, &holds);
     std::vector<std::uint8_t> changed(n, 0);
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
         SnapOptions own = o;
         own.base_rms = free_rms[i];
-        FitResult s = snap(fits[i], inputs[i], own);
+        own.hold = holds[i];
         Region& g = fitted[which[i]];
-        if (same_surface(s.surface, g.fit.surface)) return;
-        if (!chords_agree(c, s.surface, drafts[which[i]].faces)) return;
-        g.fit = std::move(s);
-        changed[i] = 1;
+        const std::span<const std::uint32_t> faces = drafts[which[i]].faces;
+        // The fully snapped surface, else the one snap_together() gave (its group's axis),
+        // while the facets are its chords; else the free fit.
+        for (FitResult s : {snap(fits[i], inputs[i], own), fits[i]}) {
+            if (same_surface(s.surface, g.fit.surface)) return;
+            if (!chords_agree(c, s.surface, faces)) continue;
+            g.fit = std::move(s);
+            changed[i] = 1;
+            return;
+        }
     });
     return static_cast<std::uint64_t>(std::count(changed.begin(), changed.end(), 1));
 }
