@@ -3130,10 +3130,7 @@ std::vector<std::string> snap_together(std::span<FitResult> fits, std::span<cons
                     out[k] = fits[i];
                     return;
                 }
-                // A plane has nothing to refit once its normal and offset are held.
-                out[k] = fits[i].surface.kind == FitKind::kPlane && (frozen & kPositionBits)
-                             ? residuals(*wanted[k], inputs[i])
-                             : refit_surface(*wanted[k], frozen, inputs[i]);
+                out[k] = refit_surface(*wanted[k], frozen, inputs[i]);
                 bad[k] = !out[k].ok || out[k].max > o.tolerance ||
                          !explains(out[k], from[i], inputs[i], o);
             });

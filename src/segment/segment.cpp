@@ -3069,21 +3069,19 @@ double coordinate_rounding(const Mesh& m) {
 /// Snapping (SnapOptions::rms_floor) allows a rise of the RMS residual of this many rounding
 /// units of the coordinates (coordinate_rounding()) whatever the noise: a change the rounding of
 /// the vertices could hide. A binary STL rounds them to floats, not at random across a face:
-/// OCCT's sh1 cylinder of radius 37.5 fits 37.4999964 at 1e-5 mm RMS on 800 vertices, and 37.5
-/// raises the RMS by 1e-6 (ten standard errors of noise that random; the unit there is 1.5e-5).
-/// A floor in the model's size instead (1e-3 of the tolerance) took NIST FTC 07's exact tori of
-/// major radius 7.63058 to 7.63: their RMS 1e-14 -> 2.5e-5 mm, where a float STL of that part
-/// rounds by 1.2e-5 and its double tessellation by 2e-14.
+/// OCCT's sh1 cylinder of radius 37.5 fits 37.4999964 (`ncrev segment occt_sh1.stl --no-snap
+/// --json`), by more standard errors than noise that random allows, and less than a unit. A
+/// floor in the model's size instead lets exact faces of a double-precision tessellation take
+/// round values far beyond its rounding.
 constexpr double kSnapRmsFloor = 1;
 
 /// A region whose fit's RMS residual exceeds the noise (plus the floor) by more than this factor
 /// is not on its surface to within the noise, as a face of the part is (a noisy region's RMS is
 /// the noise, somewhat less). It is not snapped: a cylinder piece of a free-form blend, whose
-/// values are no part's (NIST FTC 07 meshed 4 x finer: two such pieces of 3.08 mm radius went to
-/// 3, within the tolerance, and the solid 0.2 mm off the mesh where they meet their
-/// neighbours); a fillet strip that took a few vertices of its neighbour, whose radius and place
-/// trade off (FTC 07's 3.048 mm fillets, 2e-4 mm RMS on exact vertices: a test with that RMS as
-/// the noise took them to 3.05).
+/// values are no part's and whose snapped radius moves the edges it shares with its neighbours
+/// (ReverseSurfaces.TangentEdgesStayWithinTheMeshsDeflection fails when such pieces snap); a
+/// fillet strip that took a few vertices of its neighbour, whose radius and place trade off so
+/// that the points cannot tell a round radius from the true one.
 constexpr double kSnapFitNoise = 3;
 
 bool same_surface(const Surface& a, const Surface& b) {
@@ -3096,7 +3094,7 @@ bool same_surface(const Surface& a, const Surface& b) {
 /// within the tolerance and to the noise (kSnapFitNoise) get parallel axes and coaxial lines
 /// (snap_together()), then axes along coordinate axes, round positions, radii (the SRE `tools`'
 /// first) and cone angles (snap()); each change only while every vertex stays within the
-/// tolerance, the RMS as close to the free fit's as the noise (the median region's RMS) allows
+/// tolerance, the RMS as close to the free fit's as the noise (the median region's) allows
 /// (SnapOptions::noise), and the facets are chords of the surface. Regions given by SRE and
 /// loose ones (held to chords) are left as they are. Returns the regions whose surface changed.
 std::uint64_t snap_regions(Context& c, const std::vector<Draft>& drafts,
@@ -3116,9 +3114,8 @@ std::uint64_t snap_regions(Context& c, const std::vector<Draft>& drafts,
     });
     // The noise: the median of the regions' own estimates, RMS^2 n / (n - p) for n vertices and
     // p parameters (unbiased: a 2-facet plane's RMS is half the noise). The largest region's RMS
-    // (noise_level()) may be a misfit: on the sample shallow_freeform a torus piece of the
-    // free-form face, 0.0036 mm, by which a cylinder piece of radius 3924 went from 0.0004 to
-    // 0.0057 mm RMS; its planes are exact.
+    // (noise_level()) may be a misfit: on the sample shallow_freeform a torus piece of its
+    // free-form face, while its planes are exact.
     std::vector<double> estimates;
     for (std::size_t i = 0; i < which.size(); ++i) {
         const double nv = static_cast<double>(sets[i].points.size());
@@ -3146,11 +3143,9 @@ std::uint64_t snap_regions(Context& c, const std::vector<Draft>& drafts,
     sets.resize(n);
     std::vector<FitResult> fits(n);
     std::vector<FitInput> inputs(n);
-    std::vector<double> free_rms(n);
     for (std::size_t i = 0; i < n; ++i) {
         fits[i] = fitted[which[i]].fit;
         inputs[i] = sets[i].input();
-        free_rms[i] = fits[i].rms;
     }
     SnapOptions o;
     o.tolerance = c.tol;
@@ -3161,13 +3156,13 @@ std::uint64_t snap_regions(Context& c, const std::vector<Draft>& drafts,
         if (t.corner_radius > 0) o.tool_radii.push_back(t.corner_radius);
     }
     std::vector<SnapHold> holds;
-    snap_together(fits, inputs, o, free_rms, &holds);
+    snap_together(fits, inputs, o, {}, &holds);  // measured from the free fits' RMS
     std::vector<std::uint8_t> changed(n, 0);
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+        Region& g = fitted[which[i]];  // the free fit until it is replaced below
         SnapOptions own = o;
-        own.base_rms = free_rms[i];
+        own.base_rms = g.fit.rms;
         own.hold = holds[i];
-        Region& g = fitted[which[i]];
         const std::span<const std::uint32_t> faces = drafts[which[i]].faces;
         // The fully snapped surface, else the one snap_together() gave (its group's axis),
         // while the facets are its chords; else the free fit.
