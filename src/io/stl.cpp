@@ -46,7 +46,7 @@ std::uint32_t float_key(float v) {
 void take_welded_points(const detail::ExactWelder<std::uint32_t>& welder,
                         std::uint64_t input_points, TriangleSoup& soup) {
     soup.welded_points = input_points - welder.size();
-    soup.points.resize(welder.size());
+    detail::resize_huge(soup.points, welder.size());
     for (std::size_t c = 0; c < welder.size(); ++c) {
         const auto& k = welder.keys()[c];
         soup.points[c] = {std::bit_cast<float>(k[0]), std::bit_cast<float>(k[1]),
@@ -58,7 +58,8 @@ void take_welded_points(const detail::ExactWelder<std::uint32_t>& welder,
 /// Exact weld of a bucket soup whose points are float32 values (as every STL's are).
 void weld_float_points(TriangleSoup& soup) {
     detail::ExactWelder<std::uint32_t> welder(soup.points.size());
-    std::vector<std::uint32_t> id(soup.points.size());
+    std::vector<std::uint32_t> id;
+    detail::resize_huge(id, soup.points.size());
     for (std::size_t i = 0; i < soup.points.size(); ++i) {
         const Vec3 p = soup.points[i];
         id[i] =
@@ -91,7 +92,7 @@ Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_v
         while (!header.empty() && io_detail::is_space(header.back())) header.remove_suffix(1);
         for (char c : header) soup.name += (c >= 0x20 && c < 0x7f) ? c : '?';
     }
-    soup.triangles.resize(n);
+    detail::resize_huge(soup.triangles, n);
     const std::byte* rec = bytes.data() + kStlHeaderBytes;
     // The nine coordinates of facet f; an error naming the byte of the first non-finite one.
     auto load = [&](std::uint64_t f, const std::byte* r, float* c) -> std::optional<Error> {
@@ -131,7 +132,7 @@ Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_v
         take_welded_points(welder, 3 * n, soup);
         return soup;
     }
-    soup.points.resize(3 * n);
+    detail::resize_huge(soup.points, 3 * n);
     Vec3* out = soup.points.data();
     for (std::uint64_t f = 0; f < n; ++f, rec += kStlRecordBytes) {
         float c[9];
@@ -153,8 +154,8 @@ Result<TriangleSoup> read_ascii(std::span<const std::byte> bytes, std::string_vi
     // The smallest facet record is far longer than this, so a reservation from the file size
     // can never exceed what the file holds.
     constexpr std::size_t kMinAsciiFacetBytes = 64;
-    soup.triangles.reserve(bytes.size() / kMinAsciiFacetBytes);
-    soup.points.reserve(3 * (bytes.size() / kMinAsciiFacetBytes));
+    detail::reserve_huge(soup.triangles, bytes.size() / kMinAsciiFacetBytes);
+    detail::reserve_huge(soup.points, 3 * (bytes.size() / kMinAsciiFacetBytes));
 
     auto expect = [&](std::string_view keyword) -> Status {
         const std::string_view tok = sc.token();

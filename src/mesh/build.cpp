@@ -17,6 +17,7 @@
 #include <unordered_map>
 
 #include "detail/exact_weld.h"
+#include "detail/huge_pages.h"
 #include "ncrev/mesh.h"
 
 namespace ncrev {
@@ -59,7 +60,7 @@ void for_chunks(std::size_t n, Fn&& fn) {
 std::uint32_t weld_exact(std::span<const Vec3> pts, std::vector<std::uint32_t>& id,
                          std::vector<Vec3>& pos) {
     const std::size_t n = pts.size();
-    id.resize(n);
+    detail::resize_huge(id, n);
     detail::ExactWelder<std::uint64_t> welder(n);
     auto key = [](const Vec3& p) {
         return detail::ExactWelder<std::uint64_t>::Key{bits_of(p.x), bits_of(p.y), bits_of(p.z)};
@@ -69,7 +70,7 @@ std::uint32_t weld_exact(std::span<const Vec3> pts, std::vector<std::uint32_t>& 
         if (i + kPrefetchAhead < n) welder.prefetch(key(pts[i + kPrefetchAhead]));
         id[i] = welder.insert(key(pts[i]));
     }
-    pos.resize(welder.size());
+    detail::resize_huge(pos, welder.size());
     for (std::size_t c = 0; c < welder.size(); ++c) {
         const auto& k = welder.keys()[c];
         pos[c] = {std::bit_cast<double>(k[0]), std::bit_cast<double>(k[1]),
@@ -209,7 +210,8 @@ PairCounts pair_edges(std::span<const std::uint32_t> c, std::span<const Vec3> vp
     const std::size_t nv = vpos.size();
     auto nxt = [](std::size_t h) { return h % 3 == 2 ? h - 2 : h + 1; };
     auto prv = [](std::size_t h) { return h % 3 == 0 ? h + 2 : h - 1; };
-    std::vector<std::uint32_t> start(nv + 1, 0);
+    std::vector<std::uint32_t> start;
+    detail::assign_huge(start, nv + 1, 0u);
     for (std::size_t f = 0; f < nh; f += 3) {
         const std::uint32_t a = c[f], b = c[f + 1], d = c[f + 2];
         ++start[std::min(a, b) + 1];
@@ -221,17 +223,20 @@ PairCounts pair_edges(std::span<const std::uint32_t> c, std::span<const Vec3> vp
         std::uint32_t other;  // the higher vertex
         std::uint32_t h;
     };
-    std::vector<Item> items(nh);
+    std::vector<Item> items;
+    detail::resize_huge(items, nh);
     {
-        std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+        std::vector<std::uint32_t> fill;
+        detail::reserve_huge(fill, nv);
+        fill.assign(start.begin(), start.end() - 1);
         for (std::size_t h = 0; h < nh; ++h) {
             const std::uint32_t a = c[h], b = c[nxt(h)];
             const std::uint32_t lo = std::min(a, b);
             items[fill[lo]++] = {std::max(a, b), static_cast<std::uint32_t>(h)};
         }
     }
-    mate.assign(nh, kNone);
-    dup.assign(nh / 3, 0);
+    detail::assign_huge(mate, nh, kNone);
+    detail::assign_huge(dup, nh / 3, std::uint8_t{0});
     constexpr std::size_t kVertexChunk = 1 << 14;
     const std::size_t chunks = (nv + kVertexChunk - 1) / kVertexChunk;
     std::vector<PairCounts> counts(chunks);
@@ -424,12 +429,13 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     rep.input_points = num_points + soup.welded_points;
     if (soup.points_distinct) {
         rep.exact_welded_points = soup.welded_points;
-        point_vertex.resize(num_points);
+        detail::resize_huge(point_vertex, num_points);
         std::iota(point_vertex.begin(), point_vertex.end(), 0u);
         if (owned) {
             vpos = std::move(owned->points);
         } else {
-            vpos = soup.points;
+            detail::reserve_huge(vpos, soup.points.size());
+            vpos.assign(soup.points.begin(), soup.points.end());
         }
     } else {
         const std::uint32_t num_exact = weld_exact(soup.points, point_vertex, vpos);
@@ -442,7 +448,7 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     if (owned) {
         tri = std::move(owned->triangles);
     } else {
-        tri.resize(num_in);
+        detail::resize_huge(tri, num_in);
     }
     const auto& input_tri = owned ? tri : soup.triangles;
     for_chunks(num_in, [&](std::size_t b, std::size_t e) {
@@ -456,7 +462,8 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
 
     // 2. Degenerate facets: a repeated vertex, or a height below the weld tolerance.
     report_progress("pair", 0.0);
-    std::vector<std::uint32_t> kept(num_in);  // input facet index of each kept facet
+    std::vector<std::uint32_t> kept;  // input facet index of each kept facet
+    detail::resize_huge(kept, num_in);
     std::iota(kept.begin(), kept.end(), 0u);
     // Facets added by splitting (index >= num_in in `tri`) and the input facet each came from.
     std::vector<std::uint32_t> split_origin;
@@ -533,7 +540,8 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
         }
     };
     auto drop_degenerate = [&]() {
-        std::vector<std::uint8_t> bad(kept.size(), 0);
+        std::vector<std::uint8_t> bad;
+        detail::assign_huge(bad, kept.size(), std::uint8_t{0});
         for_chunks(kept.size(), [&](std::size_t b, std::size_t e) {
             for (std::size_t k = b; k < e; ++k) {
                 const auto& t = tri[kept[k]];
@@ -571,6 +579,7 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     std::vector<std::uint8_t> dup;
     bool tolerance_done = false;
     for (;;) {
+        if (corner.empty()) detail::reserve_huge(corner, 3 * kept.size());
         corner.resize(3 * kept.size());
         for_chunks(kept.size(), [&](std::size_t b, std::size_t e) {
             for (std::size_t k = b; k < e; ++k) {
@@ -623,7 +632,8 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
 
     // 4. Compact the vertices to those the kept facets use (in vertex order).
     {
-        std::vector<std::uint32_t> remap(vpos.size(), kNone);
+        std::vector<std::uint32_t> remap;
+        detail::assign_huge(remap, vpos.size(), kNone);
         for (std::uint32_t v : corner) remap[v] = 0;
         std::uint32_t nv = 0;
         for (std::size_t v = 0; v < vpos.size(); ++v) {
@@ -645,11 +655,13 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     // 6. Orientation: breadth-first over each component in facet order; a neighbour across
     // an edge both facets run the same way must be flipped relative to the current one.
     report_progress("orient", 0.0);
-    std::vector<std::uint8_t> flip(nf, 0);
-    std::vector<std::uint32_t> comp(nf, kNone);
+    std::vector<std::uint8_t> flip;
+    detail::assign_huge(flip, nf, std::uint8_t{0});
+    std::vector<std::uint32_t> comp;
+    detail::assign_huge(comp, nf, kNone);
     std::vector<std::uint32_t> comp_start;  // where each component starts in BFS order
     std::vector<std::uint32_t> bfs;
-    bfs.reserve(nf);
+    detail::reserve_huge(bfs, nf);
     for (std::size_t seed = 0; seed < nf; ++seed) {
         if (comp[seed] != kNone) continue;
         const auto c = static_cast<std::uint32_t>(comp_start.size());
@@ -730,8 +742,8 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     // in slot i to slot 2 - i.
     report_progress("finish", 0.0);
     Mesh& mesh = out.mesh;
-    mesh.origin_.resize(nh);
-    mesh.twin_.resize(nh);
+    detail::resize_huge(mesh.origin_, nh);
+    detail::resize_huge(mesh.twin_, nh);
     auto slot = [&](std::uint32_t h) -> std::uint32_t {
         const std::uint32_t f = h / 3, i = h % 3;
         return flip[f] ? 3 * f + (2 - i) : h;
@@ -767,10 +779,11 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
         const auto& twin = mesh.twin_;
         auto nxt = [](std::uint32_t h) { return h % 3 == 2 ? h - 2 : h + 1; };
         auto prv = [](std::uint32_t h) { return h % 3 == 0 ? h + 2 : h - 1; };
-        std::vector<std::uint8_t> seen(nh, 0);
-        std::vector<std::uint8_t> has_fan(nv, 0);
-        std::vector<std::uint8_t> counted(nv, 0);
-        mesh.outgoing_.assign(nv, kNone);
+        std::vector<std::uint8_t> seen, has_fan, counted;
+        detail::assign_huge(seen, nh, std::uint8_t{0});
+        detail::assign_huge(has_fan, nv, std::uint8_t{0});
+        detail::assign_huge(counted, nv, std::uint8_t{0});
+        detail::assign_huge(mesh.outgoing_, nv, kNone);
         std::vector<std::uint32_t> fan;
         for (std::uint32_t h = 0; h < nh; ++h) {
             if (seen[h]) continue;
@@ -825,9 +838,9 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     for (std::uint32_t& f : kept) f = source_of(f);
     mesh.source_face_ = std::move(kept);
     if (attrs) {
-        mesh.color_.resize(nf);
-        mesh.cut_.resize(nf);
-        mesh.surface_.resize(nf);
+        detail::resize_huge(mesh.color_, nf);
+        detail::resize_huge(mesh.cut_, nf);
+        detail::resize_huge(mesh.surface_, nf);
         for (std::size_t f = 0; f < nf; ++f) {
             const std::uint32_t s = mesh.source_face_[f];
             mesh.color_[f] = soup.color[s];
