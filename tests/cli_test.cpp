@@ -144,10 +144,23 @@ TEST(CliReverse, WritesAStepAndAReportAndRefusesToOverwriteItsInput) {
     EXPECT_TRUE(std::filesystem::exists(step));
     std::ifstream in(report);
     EXPECT_EQ(nlohmann::json::parse(in), j);
-    EXPECT_EQ(run("reverse " + stl.string() + " -o " + stl.string()).code, 1);
+    // The input as the output: refused, with no warning about its extension first.
+    const CliRun self = run("reverse " + stl.string() + " -o " + stl.string());
+    EXPECT_EQ(self.code, 1);
+    EXPECT_NE(self.err.find("is the input; ncrev never overwrites its input"), std::string::npos)
+        << self.err;
+    EXPECT_EQ(self.err.find("warning"), std::string::npos) << self.err;
     EXPECT_EQ(std::filesystem::file_size(stl), 84u + 50u * 12u);  // untouched
     EXPECT_EQ(run("reverse " + stl.string() + " -o /nonexistent/dir/x.step -q").code, 4);
-    EXPECT_EQ(run("reverse " + stl.string() + " -o " + step.string() + " --method nurbs").code, 1);
+    // An unknown keyword is named with the ones there are; keywords take any case.
+    const CliRun nurbs =
+        run("reverse " + stl.string() + " -o " + step.string() + " --method nurbs");
+    EXPECT_EQ(nurbs.code, 1);
+    EXPECT_NE(nurbs.err.find("--method: 'nurbs' is not one of: auto, facets, planar, surfaces"),
+              std::string::npos)
+        << nurbs.err;
+    EXPECT_EQ(run("reverse " + stl.string() + " -o " + step.string() + " --method PLANAR -q").code,
+              0);
     std::filesystem::remove(step);
     std::filesystem::remove(report);
     std::filesystem::remove(stl);

@@ -41,7 +41,7 @@ void add_curvature(CLI::App& app, Context& ctx) {
     cmd->add_option("--estimator", o->curvature.estimator,
                     "plain: the normal-cycle shape operator (default); weighted: with the "
                     "paper's per-edge weights (less accurate, see docs/curvature.md)")
-        ->transform(CLI::CheckedTransformer(estimators, CLI::ignore_case))
+        ->transform(keywords(estimators))
         ->option_text("plain|weighted");
     std::map<std::string, Neighbourhood> neighbourhoods;
     for (const Neighbourhood n : {Neighbourhood::kSmoothed, Neighbourhood::kKernel,
@@ -53,7 +53,7 @@ void add_curvature(CLI::App& app, Context& ctx) {
                     "kernel of about three edges, never beyond a small arc of the surface; "
                     "kernel: the same kernel summed exactly (slower); rings: the cells of the "
                     "--rings ring; geodesic: the cells within --radius along edges")
-        ->transform(CLI::CheckedTransformer(neighbourhoods, CLI::ignore_case))
+        ->transform(keywords(neighbourhoods))
         ->option_text("smoothed|kernel|rings|geodesic");
     cmd->add_option("--rings", o->curvature.rings, "Rings of the 'rings' neighbourhood")
         ->capture_default_str()

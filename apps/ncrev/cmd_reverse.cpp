@@ -53,7 +53,7 @@ void add_reverse(CLI::App& app, Context& ctx) {
                     "its mesh edges (or as its facets); surfaces: "
                     "true surfaces or nothing; planar: coplanar facets merged; facets: one face "
                     "per facet")
-        ->transform(CLI::CheckedTransformer(methods, CLI::ignore_case))
+        ->transform(keywords(methods))
         ->option_text("auto|surfaces|planar|facets");
     cmd->add_option("--labels", o->labels,
                     "auto/surfaces: also write the region of every input facet, one per line, "
@@ -77,7 +77,7 @@ void add_reverse(CLI::App& app, Context& ctx) {
                                                     {"ap203", StepSchema::kAP203},
                                                     {"ap242", StepSchema::kAP242}};
     cmd->add_option("--schema", o->schema, "STEP application protocol (default ap214)")
-        ->transform(CLI::CheckedTransformer(schemas, CLI::ignore_case))
+        ->transform(keywords(schemas))
         ->option_text("ap214|ap203|ap242");
     cmd->add_option("--report", o->report,
                     "Write a JSON report: stages with timings, healing, regions, faces by kind, "
@@ -99,6 +99,9 @@ void add_reverse(CLI::App& app, Context& ctx) {
             }
             if (!extra->empty() && refuses_folder(*extra, ctx)) return;
         }
+        auto healed = read_input(in, out, ctx, o->quiet);
+        if (!healed) return;
+        // After read_input(): an output refused (the input, a folder) gets no warning first.
         if (std::string ext = out.extension().string(); !o->quiet) {
             for (char& ch : ext)
                 ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
@@ -108,8 +111,6 @@ void add_reverse(CLI::App& app, Context& ctx) {
                               ".step or .stp");
             }
         }
-        auto healed = read_input(in, out, ctx, o->quiet);
-        if (!healed) return;
         const auto progress = terminal_progress(ctx, o->quiet);
         if (o->require_solid && !healed->report.mesh.closed) {
             print_error(o->input + ": the mesh is open (" +

@@ -42,7 +42,7 @@ void add_segment(CLI::App& app, Context& ctx) {
                     "facets (default): sharp edges, then regions grown facet by facet while one "
                     "surface fits, merged, their borders refined; paper: the paper's vertex "
                     "method (curvature types, refining, connected regions, merging)")
-        ->transform(CLI::CheckedTransformer(methods, CLI::ignore_case))
+        ->transform(keywords(methods))
         ->option_text("facets|paper");
     cmd->add_option("--labels", o->labels,
                     "Also write one region id per input facet, one per line, in input order "

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -49,6 +50,25 @@ std::function<void(std::string_view stage, double fraction)> terminal_progress(c
 /// positive number, got -1", not the range up to DBL_MAX written out in full. Finite only.
 extern const CLI::Validator kPositive;
 extern const CLI::Validator kNonNegative;
+
+/// A keyword option's transform: the text, in any case, must be a key of `choices` and becomes
+/// its value; any other text is refused with "'x' is not one of: a, b, c" (CLI11's own
+/// CheckedTransformer would print its whole map, values as numbers).
+template <class T>
+CLI::Validator keywords(const std::map<std::string, T>& choices) {
+    std::string list;
+    for (const auto& entry : choices) list += (list.empty() ? "" : ", ") + entry.first;
+    const CLI::Validator convert = CLI::CheckedTransformer(choices, CLI::ignore_case);
+    return CLI::Validator(
+        [choices, list, convert](std::string& text) -> std::string {
+            const std::string lower = CLI::detail::to_lower(text);
+            for (const auto& entry : choices) {
+                if (CLI::detail::to_lower(entry.first) == lower) return convert(text);
+            }
+            return "'" + text + "' is not one of: " + list;
+        },
+        "", "KEYWORD");
+}
 
 /// Prints "error: <message>" to stderr.
 void print_error(const std::string& message);
