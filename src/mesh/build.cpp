@@ -422,15 +422,14 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     }
     const double tol = rep.tolerance;
 
-    // 1. Exact weld: point -> vertex (unless the reader already welded).
+    // 1. Exact weld: point -> vertex (unless the reader already welded: then the points are
+    // the vertices and the triangles are taken as they are).
     report_progress("weld", 0.0);
     std::vector<std::uint32_t> point_vertex;
     std::vector<Vec3> vpos;
     rep.input_points = num_points + soup.welded_points;
     if (soup.points_distinct) {
         rep.exact_welded_points = soup.welded_points;
-        detail::resize_huge(point_vertex, num_points);
-        std::iota(point_vertex.begin(), point_vertex.end(), 0u);
         if (owned) {
             vpos = std::move(owned->points);
         } else {
@@ -448,15 +447,16 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     if (owned) {
         tri = std::move(owned->triangles);
     } else {
-        detail::resize_huge(tri, num_in);
+        detail::reserve_huge(tri, num_in);
+        tri.assign(soup.triangles.begin(), soup.triangles.end());
     }
-    const auto& input_tri = owned ? tri : soup.triangles;
-    for_chunks(num_in, [&](std::size_t b, std::size_t e) {
-        for (std::size_t f = b; f < e; ++f) {
-            const auto& t = input_tri[f];
-            tri[f] = {point_vertex[t[0]], point_vertex[t[1]], point_vertex[t[2]]};
-        }
-    });
+    if (!soup.points_distinct) {
+        for_chunks(num_in, [&](std::size_t b, std::size_t e) {
+            for (std::size_t f = b; f < e; ++f) {
+                for (std::uint32_t& v : tri[f]) v = point_vertex[v];
+            }
+        });
+    }
     point_vertex = {};
     report_progress("weld", 1.0);
 

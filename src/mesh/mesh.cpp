@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include "detail/huge_pages.h"
+
 namespace ncrev {
 
 Vec3 Mesh::face_normal_area2(FaceId f) const {
@@ -105,7 +107,8 @@ MeshStats compute_stats(const Mesh& mesh) {
     s.volume = vol6 / 6.0;
 
     // Components: faces joined across twins.
-    std::vector<std::uint32_t> comp(nf, HalfedgeId::kInvalid);
+    std::vector<std::uint32_t> comp;
+    detail::assign_huge(comp, nf, std::uint32_t{HalfedgeId::kInvalid});
     std::vector<std::uint32_t> stack;
     for (std::size_t seed = 0; seed < nf; ++seed) {
         if (comp[seed] != HalfedgeId::kInvalid) continue;
@@ -128,8 +131,8 @@ MeshStats compute_stats(const Mesh& mesh) {
 
     // Boundary loops: from a boundary half-edge, the next one starts at its target and is
     // that vertex's outgoing half-edge (the one without twin).
-    std::vector<std::uint8_t> seen(nh, 0);
-    for (std::size_t h = 0; h < nh; ++h) {
+    std::vector<std::uint8_t> seen(boundary > 0 ? nh : 0, 0);  // a closed mesh has none
+    for (std::size_t h = 0; h < nh && boundary > 0; ++h) {
         if (seen[h] || mesh.twins()[h] != HalfedgeId::kInvalid) continue;
         std::uint32_t len = 0;
         HalfedgeId g(static_cast<std::uint32_t>(h));
