@@ -435,13 +435,18 @@ TEST(ReverseSurfaces, OpenMeshIsPlanarInAutoAndNothingInSurfaces) {
     EXPECT_FALSE(a->solid);
 }
 
-// Same mesh, same STEP, whatever the run.
+// Same mesh, same STEP, whatever the run and the thread count.
 TEST(ReverseSurfaces, Deterministic) {
     const SamplePart part = make("fillet_chamfer_block", kFine);
     const Outcome a = reverse_part(part, false, ReverseMethod::kAuto, "det_a");
     const Outcome b = reverse_part(part, false, ReverseMethod::kAuto, "det_b");
     ASSERT_FALSE(a.step_text.empty());
     EXPECT_EQ(a.step_text, b.step_text);
+    const Outcome one = [&] {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        return reverse_part(part, false, ReverseMethod::kAuto, "det_one");
+    }();
+    EXPECT_EQ(a.step_text, one.step_text);
 }
 
 // The fillet block's rolling-ball corners in `o` (see the test below): each within twice the
