@@ -738,37 +738,31 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     comp = {};
     report_progress("orient", 1.0);
 
-    // 7. The half-edge columns. Flipping facet (v0 v1 v2) to (v0 v2 v1) moves its half-edge
-    // in slot i to slot 2 - i.
+    // 7. The half-edge columns, in place of the corners and the mates (a face's half-edges
+    // stay within it). Flipping facet (v0 v1 v2) to (v0 v2 v1) moves its half-edge in slot i
+    // to slot 2 - i.
     report_progress("finish", 0.0);
     Mesh& mesh = out.mesh;
-    detail::resize_huge(mesh.origin_, nh);
-    detail::resize_huge(mesh.twin_, nh);
     auto slot = [&](std::uint32_t h) -> std::uint32_t {
         const std::uint32_t f = h / 3, i = h % 3;
         return flip[f] ? 3 * f + (2 - i) : h;
     };
     for_chunks(nf, [&](std::size_t b, std::size_t e) {
         for (std::size_t f = b; f < e; ++f) {
-            const std::uint32_t* c = &corner[3 * f];
-            std::uint32_t* o = &mesh.origin_[3 * f];
-            if (flip[f]) {
-                o[0] = c[0];
-                o[1] = c[2];
-                o[2] = c[1];
-            } else {
-                o[0] = c[0];
-                o[1] = c[1];
-                o[2] = c[2];
-            }
+            std::uint32_t* c = &corner[3 * f];
+            std::uint32_t* m = &mate[3 * f];
+            const std::uint32_t own[3] = {m[0], m[1], m[2]};
             for (int k = 0; k < 3; ++k) {
                 const auto h = static_cast<std::uint32_t>(3 * f + k);
-                mesh.twin_[slot(h)] = mate[h] == kNone ? kNone : slot(mate[h]);
+                m[slot(h) - 3 * f] = own[k] == kNone ? kNone : slot(own[k]);
             }
+            if (flip[f]) std::swap(c[1], c[2]);
         }
     });
-    mate = {};
-    corner = {};
+    corner.resize(nh);
+    mate.resize(nh);
+    mesh.origin_ = std::move(corner);
+    mesh.twin_ = std::move(mate);
     flip = {};
 
     // 8. Split non-manifold vertices: every fan of half-edges around a vertex beyond its
