@@ -2,6 +2,8 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <numbers>
 
 #include "ncrev/mesh.h"
@@ -356,23 +358,57 @@ TEST(MeshBuildDeterminism, SameMeshWhateverTheThreadCount) {
 namespace ncrev {
 namespace {
 
+// Small files are welded in one pass, large ones (from 65536 facets) in two halves at once and
+// merged: the same mesh either way, numbered as the file orders its points, on any thread count.
 TEST(MeshBuildInvariance, WeldingWhileReadingGivesTheSameMeshAndCounts) {
-    auto m = test::merge(test::icosphere(4.0, 3), test::cube({9, 0, 0}, 2.0));
-    m.triangles.push_back(m.triangles[5]);  // a duplicate
-    const auto bytes = encode_stl_binary(m.points, m.triangles);
+    for (const int level : {3, 6}) {
+        auto m = test::merge(test::icosphere(4.0, level), test::cube({9, 0, 0}, 2.0));
+        m.triangles.push_back(m.triangles[5]);  // a duplicate
+        const auto bytes = encode_stl_binary(m.points, m.triangles);
+        ReadOptions weld;
+        weld.weld_exact = true;
+        auto a = read_stl(bytes);
+        auto b = read_stl(bytes, {}, weld);
+        auto c = [&] {
+            tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+            return read_stl(bytes, {}, weld);
+        }();
+        ASSERT_TRUE(a.ok() && b.ok() && c.ok());
+        EXPECT_EQ(b->points, c->points) << level;
+        EXPECT_EQ(b->triangles, c->triangles) << level;
+        auto ma = build_ok(*a), mb = build_ok(std::move(b).value());
+        EXPECT_TRUE(std::ranges::equal(ma.mesh.origins(), mb.mesh.origins())) << level;
+        EXPECT_TRUE(std::ranges::equal(ma.mesh.twins(), mb.mesh.twins())) << level;
+        EXPECT_TRUE(std::ranges::equal(ma.mesh.positions(), mb.mesh.positions())) << level;
+        EXPECT_EQ(ma.heal.input_points, mb.heal.input_points);
+        EXPECT_EQ(ma.heal.exact_welded_points, mb.heal.exact_welded_points);
+        EXPECT_EQ(ma.heal.duplicate_facets_removed, 1u);
+        EXPECT_EQ(mb.heal.duplicate_facets_removed, 1u);
+    }
+}
+
+// The two halves of a large file are read at once; a non-finite coordinate is still reported
+// at its byte, the earliest one when both halves have one.
+TEST(MeshBuildInvariance, WeldingWhileReadingReportsTheFirstBadCoordinate) {
+    const auto m = test::icosphere(4.0, 6);  // 81920 facets: welded in two halves
+    const auto good = encode_stl_binary(m.points, m.triangles);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    // Facet f, vertex 1, z: header 84 + f records + normal 12 + vertex 12 + 8.
+    const auto at = [](std::size_t f) { return 84 + 50 * f + 12 + 12 + 8; };
     ReadOptions weld;
     weld.weld_exact = true;
-    auto a = read_stl(bytes);
-    auto b = read_stl(bytes, {}, weld);
-    ASSERT_TRUE(a.ok() && b.ok());
-    auto ma = build_ok(*a), mb = build_ok(std::move(b).value());
-    EXPECT_TRUE(std::ranges::equal(ma.mesh.origins(), mb.mesh.origins()));
-    EXPECT_TRUE(std::ranges::equal(ma.mesh.twins(), mb.mesh.twins()));
-    EXPECT_TRUE(std::ranges::equal(ma.mesh.positions(), mb.mesh.positions()));
-    EXPECT_EQ(ma.heal.input_points, mb.heal.input_points);
-    EXPECT_EQ(ma.heal.exact_welded_points, mb.heal.exact_welded_points);
-    EXPECT_EQ(ma.heal.duplicate_facets_removed, 1u);
-    EXPECT_EQ(mb.heal.duplicate_facets_removed, 1u);
+    for (const std::vector<std::size_t>& bad :
+         {std::vector<std::size_t>{70000}, {100, 70000}, {40960, 70000}, {40959}}) {
+        auto bytes = good;
+        for (const std::size_t f : bad) std::memcpy(bytes.data() + at(f), &nan, 4);
+        for (const bool welding : {false, true}) {
+            auto r = read_stl(bytes, {}, welding ? weld : ReadOptions{});
+            ASSERT_FALSE(r.ok());
+            EXPECT_EQ(r.error().code, ErrorCode::kBadNumber);
+            EXPECT_EQ(r.error().byte_offset, static_cast<std::int64_t>(at(bad.front())))
+                << bad.front() << (welding ? " welding" : "");
+        }
+    }
 }
 
 }  // namespace

@@ -1,5 +1,9 @@
 // STL reader (ASCII and binary). Binary is recognised by its size, 84 + 50·n bytes with n the
 // header's facet count, because many binary files begin with the word "solid".
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
 #include <bit>
 #include <cstring>
 #include <optional>
@@ -19,6 +23,9 @@ constexpr std::size_t kStlHeaderBytes = 84;  // 80-byte header + uint32 facet co
 constexpr std::size_t kStlRecordBytes = 50;  // normal, 3 vertices (12 float32), uint16 attribute
 // Three 32-bit point ids per facet: beyond this many facets the ids would overflow.
 constexpr std::uint64_t kMaxFacets = 0xFFFFFFFEull / 3;
+// From this many facets a binary STL is welded in two halves at once (see read_binary()):
+// below it, the second table and the merge cost more than the half they save.
+constexpr std::uint64_t kTwoBlockWeldFacets = 1 << 16;
 
 Error make_error(ErrorCode code, std::string_view name, std::string message, std::int64_t line = -1,
                  std::int64_t offset = -1) {
@@ -109,27 +116,58 @@ Result<TriangleSoup> read_binary(std::span<const std::byte> bytes, std::string_v
     if (weld) {
         // Weld while reading: the soup holds each vertex once (a third of the memory of
         // three points per facet) and the keys are the file's own float32 bits.
-        detail::ExactWelder<std::uint32_t> welder(3 * n);
-        // Prefetch the table slots of the vertices a few facets ahead: a new vertex (one in
-        // six) misses the large table, and its cost is a memory round trip otherwise.
-        constexpr std::uint64_t kPrefetchFacets = 8;
-        for (std::uint64_t f = 0; f < n; ++f, rec += kStlRecordBytes) {
-            float c[9];
-            if (auto bad = load(f, rec, c)) return *bad;
-            if (f + kPrefetchFacets < n) {
-                float a[9];
-                std::memcpy(a, rec + kPrefetchFacets * kStlRecordBytes + 12, sizeof a);
+        // Facets [begin, end) into `welder`, their corners as its classes; the first
+        // non-finite coordinate's error, if any.
+        auto weld_range = [&](detail::ExactWelder<std::uint32_t>& welder, std::uint64_t begin,
+                              std::uint64_t end) -> std::optional<Error> {
+            // Prefetch the table slots of the vertices a few facets ahead: a new vertex (one
+            // in six) misses the large table, and its cost is a memory round trip otherwise.
+            constexpr std::uint64_t kPrefetchFacets = 8;
+            const std::byte* r = bytes.data() + kStlHeaderBytes + begin * kStlRecordBytes;
+            for (std::uint64_t f = begin; f < end; ++f, r += kStlRecordBytes) {
+                float c[9];
+                if (auto bad = load(f, r, c)) return bad;
+                if (f + kPrefetchFacets < end) {
+                    float a[9];
+                    std::memcpy(a, r + kPrefetchFacets * kStlRecordBytes + 12, sizeof a);
+                    for (int k = 0; k < 3; ++k) {
+                        welder.prefetch({float_key(a[3 * k]), float_key(a[3 * k + 1]),
+                                         float_key(a[3 * k + 2])});
+                    }
+                }
                 for (int k = 0; k < 3; ++k) {
-                    welder.prefetch(
-                        {float_key(a[3 * k]), float_key(a[3 * k + 1]), float_key(a[3 * k + 2])});
+                    soup.triangles[f][k] = welder.insert(
+                        {float_key(c[3 * k]), float_key(c[3 * k + 1]), float_key(c[3 * k + 2])});
                 }
             }
-            for (int k = 0; k < 3; ++k) {
-                soup.triangles[f][k] = welder.insert(
-                    {float_key(c[3 * k]), float_key(c[3 * k + 1]), float_key(c[3 * k + 2])});
-            }
+            return std::nullopt;
+        };
+        detail::ExactWelder<std::uint32_t> first(3 * n);  // sized for the whole file
+        if (n < kTwoBlockWeldFacets) {
+            if (auto bad = weld_range(first, 0, n)) return *bad;
+        } else {
+            // Two halves welded at once, then the second's classes inserted into the first's
+            // welder in their order: a class the first half has keeps its number, a new one
+            // takes the next. The same numbering as one pass over the file (by first
+            // occurrence), whatever the thread count.
+            const std::uint64_t half = n / 2;
+            detail::ExactWelder<std::uint32_t> second(3 * (n - half));
+            std::optional<Error> bad_first, bad_second;
+            tbb::parallel_invoke([&] { bad_first = weld_range(first, 0, half); },
+                                 [&] { bad_second = weld_range(second, half, n); });
+            if (bad_first) return *bad_first;  // the earlier byte
+            if (bad_second) return *bad_second;
+            std::vector<std::uint32_t> to_first;
+            detail::resize_huge(to_first, second.size());
+            for (std::size_t k = 0; k < second.size(); ++k)
+                to_first[k] = first.insert(second.keys()[k]);
+            tbb::parallel_for(tbb::blocked_range<std::uint64_t>(half, n, 1 << 15),
+                              [&](const tbb::blocked_range<std::uint64_t>& range) {
+                                  for (std::uint64_t f = range.begin(); f != range.end(); ++f)
+                                      for (auto& v : soup.triangles[f]) v = to_first[v];
+                              });
         }
-        take_welded_points(welder, 3 * n, soup);
+        take_welded_points(first, 3 * n, soup);
         return soup;
     }
     detail::resize_huge(soup.points, 3 * n);
