@@ -358,10 +358,10 @@ TEST(MeshBuildDeterminism, SameMeshWhateverTheThreadCount) {
 namespace ncrev {
 namespace {
 
-// Small files are welded in one pass, large ones (from 65536 facets) in two halves at once and
+// Small files are welded in one pass, large ones (from 262144 facets) in two halves at once and
 // merged: the same mesh either way, numbered as the file orders its points, on any thread count.
 TEST(MeshBuildInvariance, WeldingWhileReadingGivesTheSameMeshAndCounts) {
-    for (const int level : {3, 6}) {
+    for (const int level : {3, 7}) {
         auto m = test::merge(test::icosphere(4.0, level), test::cube({9, 0, 0}, 2.0));
         m.triangles.push_back(m.triangles[5]);  // a duplicate
         const auto bytes = encode_stl_binary(m.points, m.triangles);
@@ -390,7 +390,7 @@ TEST(MeshBuildInvariance, WeldingWhileReadingGivesTheSameMeshAndCounts) {
 // The two halves of a large file are read at once; a non-finite coordinate is still reported
 // at its byte, the earliest one when both halves have one.
 TEST(MeshBuildInvariance, WeldingWhileReadingReportsTheFirstBadCoordinate) {
-    const auto m = test::icosphere(4.0, 6);  // 81920 facets: welded in two halves
+    const auto m = test::icosphere(4.0, 7);  // 327680 facets: welded in two halves
     const auto good = encode_stl_binary(m.points, m.triangles);
     const float nan = std::numeric_limits<float>::quiet_NaN();
     // Facet f, vertex 1, z: header 84 + f records + normal 12 + vertex 12 + 8.
@@ -398,7 +398,7 @@ TEST(MeshBuildInvariance, WeldingWhileReadingReportsTheFirstBadCoordinate) {
     ReadOptions weld;
     weld.weld_exact = true;
     for (const std::vector<std::size_t>& bad :
-         {std::vector<std::size_t>{70000}, {100, 70000}, {40960, 70000}, {40959}}) {
+         {std::vector<std::size_t>{200000}, {100, 200000}, {163840, 200000}, {163839}}) {
         auto bytes = good;
         for (const std::size_t f : bad) std::memcpy(bytes.data() + at(f), &nan, 4);
         for (const bool welding : {false, true}) {
