@@ -61,9 +61,8 @@ CLI::Validator keywords(const std::map<std::string, T>& choices) {
     const CLI::Validator convert = CLI::CheckedTransformer(choices, CLI::ignore_case);
     return CLI::Validator(
         [choices, list, convert](std::string& text) -> std::string {
-            const std::string lower = CLI::detail::to_lower(text);
             for (const auto& entry : choices) {
-                if (CLI::detail::to_lower(entry.first) == lower) return convert(text);
+                if (CLI::ignore_case(entry.first) == CLI::ignore_case(text)) return convert(text);
             }
             return "'" + text + "' is not one of: " + list;
         },

@@ -47,9 +47,10 @@ void resize_huge(std::vector<T, A>& v, std::size_t n) {
 /// Sizes `v` to `n` copies of `value`, asking for huge pages before the first touch.
 template <class T, class A>
 void assign_huge(std::vector<T, A>& v, std::size_t n, const T& value) {
+    const T copy = value;  // `value` may be an element of `v`
     v.clear();
     reserve_huge(v, n);
-    v.assign(n, value);
+    v.assign(n, copy);
 }
 
 }  // namespace ncrev::detail
