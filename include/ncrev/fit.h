@@ -256,8 +256,8 @@ struct SnapHold {
     bool line = false;
 };
 
-/// The number of parameters of a kind's model: plane 3, sphere 4, cylinder 5, cone 6, torus 7;
-/// 0 for the others.
+/// The number of parameters of a kind's model: plane 3, sphere 4, cylinder 5, cone 6, torus and
+/// shear cylinder 7, swept torus 8; 0 for a B-spline (its count depends on its net).
 int fit_parameters(FitKind kind);
 
 /// What snap() may do. Every change is kept only when the refitted surface (the snapped values

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <vector>
 
 #if defined(__linux__)
@@ -29,11 +30,16 @@ inline void advise_huge([[maybe_unused]] const void* p, [[maybe_unused]] std::si
 #endif
 }
 
-/// Reserves room for `n` elements in `v`, on huge pages.
+/// Reserves room for `n` elements in `v`, on huge pages: a new buffer is advised before the
+/// elements move into it.
 template <class T, class A>
 void reserve_huge(std::vector<T, A>& v, std::size_t n) {
-    v.reserve(n);
-    advise_huge(v.data(), v.capacity() * sizeof(T));
+    if (n <= v.capacity()) return;
+    std::vector<T, A> room(v.get_allocator());
+    room.reserve(n);
+    advise_huge(room.data(), room.capacity() * sizeof(T));
+    room.insert(room.end(), std::make_move_iterator(v.begin()), std::make_move_iterator(v.end()));
+    v.swap(room);
 }
 
 /// Sizes `v` to `n` value-initialised elements, asking for huge pages before the first touch.

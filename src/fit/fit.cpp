@@ -2943,9 +2943,14 @@ int fit_parameters(FitKind kind) {
             return ConeModel::N;
         case FitKind::kTorus:
             return TorusModel::N;
-        default:
-            return 0;
+        case FitKind::kShearCylinder:
+            return ShearModel::N;
+        case FitKind::kSweptTorus:
+            return SweptModel::N;
+        case FitKind::kBSpline:
+            break;
     }
+    return 0;
 }
 
 FitResult snap(const FitResult& fit0, const FitInput& in, const SnapOptions& o,

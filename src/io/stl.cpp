@@ -24,9 +24,9 @@ constexpr std::size_t kStlRecordBytes = 50;  // normal, 3 vertices (12 float32),
 // Three 32-bit point ids per facet: beyond this many facets the ids would overflow.
 constexpr std::uint64_t kMaxFacets = 0xFFFFFFFEull / 3;
 // From this many facets a binary STL is welded in two halves at once (see read_binary()):
-// below it one pass's table stays in cache, and a second table and the merge cost more than
-// the half they save (BM_ReadStlBinaryWelding at 100k facets: 3.0-3.3 ms in one pass, 5.3-5.6
-// ms in two halves; at 1M, 201-211 ms against 103-108 ms).
+// below it one pass's table stays in cache, and a second table and the merge cost about what
+// the half saves (BM_ReadStlBinaryWelding, built with this at 1 << 30 and at 1 << 16: one pass
+// is the faster at 100k facets, two halves by 6 % at 1M and 18 % at 5M; docs/benchmarks.md).
 constexpr std::uint64_t kTwoBlockWeldFacets = 1 << 18;
 
 Error make_error(ErrorCode code, std::string_view name, std::string message, std::int64_t line = -1,

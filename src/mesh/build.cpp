@@ -759,13 +759,10 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
             if (flip[f]) std::swap(c[1], c[2]);
         }
     });
-    corner.resize(nh);
-    mate.resize(nh);
-    // Sized for the facets before duplicates and degenerate ones went: a file made largely
-    // of those would keep the room for the mesh's lifetime.
-    constexpr std::size_t kSpareEighths = 1;
-    if (corner.capacity() > nh + kSpareEighths * nh / 8) corner.shrink_to_fit();
-    if (mate.capacity() > nh + kSpareEighths * nh / 8) mate.shrink_to_fit();
+    // Both hold nh entries, in room sized for the facets before duplicates and degenerate ones
+    // went: a file made largely of those would keep it for the mesh's lifetime.
+    for (std::vector<std::uint32_t>* column : {&corner, &mate})
+        if (column->capacity() > nh + nh / 8) column->shrink_to_fit();
     mesh.origin_ = std::move(corner);
     mesh.twin_ = std::move(mate);
     flip = {};

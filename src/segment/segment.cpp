@@ -1301,23 +1301,7 @@ std::uint64_t merge_regions(Context& c, std::vector<Draft>& drafts, bool fragmen
 /// The numbers that fix a surface: an analytic kind's parameters; a B-spline's pole heights over
 /// its plane (a net), or its profile poles' two coordinates and the direction (an extrusion).
 std::size_t free_parameters(const Surface& s) {
-    switch (s.kind) {
-        case FitKind::kPlane:
-            return 3;
-        case FitKind::kSphere:
-            return 4;
-        case FitKind::kCylinder:
-            return 5;
-        case FitKind::kCone:
-            return 6;
-        case FitKind::kTorus:
-        case FitKind::kShearCylinder:
-            return 7;
-        case FitKind::kSweptTorus:
-            return 8;
-        case FitKind::kBSpline:
-            break;
-    }
+    if (s.kind != FitKind::kBSpline) return static_cast<std::size_t>(fit_parameters(s.kind));
     if (!s.bspline) return 0;
     const auto nu = static_cast<std::size_t>(s.bspline->num_u),
                nv = static_cast<std::size_t>(s.bspline->num_v);
