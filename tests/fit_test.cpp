@@ -684,6 +684,45 @@ TEST(FitBSpline, PlanesStayPlanesAndNonHeightFieldsFail) {
     EXPECT_EQ(below.surface.bspline->num_u * below.surface.bspline->num_v, 64 * 64);
 }
 
+// refuse_rms for B-splines: a free-form patch of many points is fitted as it is without, to
+// the bit (its sample's net holds the sample); a whole cylinder, no height field and no open
+// profile, is refused on its sample's nets, and its whole fit fails too; a fit of fewer points
+// than kSampledFitPoints is never sampled.
+TEST(FitBSpline, ManyPointsOffTheirSampleFitAreRefusedWithoutTheWholeFit) {
+    test::Rng rng(37);
+    const Patch p = freeform_patch(rng, 2 * kSampledFitPoints);
+    const double tol = 1e-3 * p.size;
+    FitInput in{p.points, p.normals, {}};
+    const FitResult whole = fit_bspline(in, tol);
+    ASSERT_TRUE(whole.ok) << whole.failure;
+    in.refuse_rms = 3 * tol;
+    const FitResult sampled = fit_bspline(in, tol);
+    ASSERT_TRUE(sampled.ok) << sampled.failure;
+    EXPECT_EQ(sampled.rms, whole.rms);
+    EXPECT_EQ(sampled.max, whole.max);
+    EXPECT_EQ(sampled.surface.bspline->poles, whole.surface.bspline->poles);
+
+    const Patch tube = cylinder_patch(rng, 5, 360, 20, 2 * kSampledFitPoints);
+    const double t = 1e-3 * tube.size;
+    FitInput round{tube.points, tube.normals, {}};
+    const FitResult tube_whole = fit_bspline(round, t);
+    EXPECT_FALSE(tube_whole.ok);
+    EXPECT_EQ(tube_whole.failure.find("sample"), std::string::npos) << tube_whole.failure;
+    round.refuse_rms = 3 * t;
+    const FitResult refused = fit_bspline(round, t);
+    EXPECT_FALSE(refused.ok);
+    EXPECT_NE(refused.failure.find("sample"), std::string::npos) << refused.failure;
+
+    const std::size_t few = kSampledFitPoints / 2;
+    FitInput small{std::span<const Vec3>(tube.points).first(few),
+                   std::span<const Vec3>(tube.normals).first(few),
+                   {}};
+    small.refuse_rms = 3 * t;
+    const FitResult small_fit = fit_bspline(small, t);
+    EXPECT_FALSE(small_fit.ok);
+    EXPECT_EQ(small_fit.failure.find("sample"), std::string::npos) << small_fit.failure;
+}
+
 // A pocket wall cut along a spline outline: a lobed profile over 270 degrees (it folds back
 // over its mean plane, so no height field), extruded along a tilted direction, sampled as a
 // mesh samples it — the two rims and a middle row, dense on the bends and sparse between.

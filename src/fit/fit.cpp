@@ -2698,18 +2698,6 @@ FitResult fit_helical(const FitInput& in, double tolerance) {
     return helical_sweep(in, tolerance);
 }
 
-FitResult fit_bspline(const FitInput& in, double tolerance) {
-    if (std::optional<FitResult> bad = unfit_for_bspline(in)) return *bad;
-    // A wall extruded along one direction first: its net is a profile's, not a grid's.
-    bool capped = false;
-    FitResult extrusion = fit_extrusion(in, tolerance, capped);
-    if (extrusion.ok) return extrusion;
-    // An extrusion whose profile would need more poles than the caller takes is still one: no
-    // net over its mean plane either.
-    if (capped) return extrusion;
-    return fit_bspline_impl(in, tolerance);
-}
-
 namespace {
 
 /// x as a message shows it: six significant digits.
@@ -2775,6 +2763,32 @@ FitResult with_model(const Surface& s, F&& f) {
 }
 
 }  // namespace
+
+FitResult fit_bspline(const FitInput& in, double tolerance) {
+    if (std::optional<FitResult> bad = unfit_for_bspline(in)) return *bad;
+    // The sample first (FitInput::refuse_rms). Its best net is refused too when it misses: a
+    // group of pieces half a part's size, far from any height field, took a second of nets
+    // over all its points to find none.
+    const std::size_t n = in.points.size();
+    if (in.refuse_rms > 0 && n >= kSampledFitPoints) {
+        const Strided strided(in, n / kRefuseSamplePoints);
+        FitInput sample = strided.input(in);
+        sample.refuse_rms = 0;
+        const FitResult look = fit_bspline(sample, tolerance);
+        if (look.rms > in.refuse_rms) {
+            return failed(FitKind::kBSpline,
+                          "a sample of the points is off its fit by RMS " + number(look.rms));
+        }
+    }
+    // A wall extruded along one direction first: its net is a profile's, not a grid's.
+    bool capped = false;
+    FitResult extrusion = fit_extrusion(in, tolerance, capped);
+    if (extrusion.ok) return extrusion;
+    // An extrusion whose profile would need more poles than the caller takes is still one: no
+    // net over its mean plane either.
+    if (capped) return extrusion;
+    return fit_bspline_impl(in, tolerance);
+}
 
 FitResult refit(const Surface& start, const FitInput& in) {
     const FitKind kind = start.kind;

@@ -1359,6 +1359,10 @@ FitResult fit_group(Context& c, std::span<const std::uint32_t> faces, const Piec
         std::max(1, (static_cast<int>(std::min<std::size_t>(whole.parameters, 1u << 20)) - 3) / 2);
     // A net is taken with at most kFreeformMaxPoles (below): none larger is fitted.
     in.max_net_poles = kFreeformMaxPoles;
+    // A large group that a strided sample of its points refuses is not fitted whole (as
+    // fit_faces()): the fillet block at 950k facets is one group of 423k vertices, off every
+    // net by an RMS of a millimetre.
+    in.refuse_rms = kSampleRefuseTolerances * c.sag;
     FitResult r = fit_bspline(in, c.sag);
     if (r.ok &&
         (r.max > c.sag || r.surface.bspline->num_u * r.surface.bspline->num_v > kFreeformMaxPoles))
