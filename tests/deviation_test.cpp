@@ -24,9 +24,11 @@ namespace {
 
 // A cylinder turned about a skew axis: BRepMesh gives its side long thin triangles along the
 // axis, none parallel to the coordinate axes, their boxes overlapping. The mesh: the same
-// cylinder at 64 x 24 cells with fans on the caps, its side pushed in and out by up to 0.3 mm,
-// so that every distance is its own. The tree search must give the brute-force distances.
-TEST(Deviation, TreeDistancesAreTheBruteForceOnes) {
+// cylinder at `around` x `along` cells with fans on the caps, its side pushed in and out by up to
+// 0.3 mm, so that every distance is its own. The tree search must give the brute-force
+// distances: at 64 x 24 cells (3200 facets), and at 256 x 36 (18944 facets), whose tree builds
+// its two halves at once (TriangleTree's kParallelBuild, 16384).
+void expect_brute_force_distances(int around, int along) {
     gp_Trsf turn;
     turn.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(1, 2, 3)), 0.7);
     constexpr double kRadius = 10, kHeight = 30;
@@ -40,29 +42,28 @@ TEST(Deviation, TreeDistancesAreTheBruteForceOnes) {
     };
     test::Rng rng(5);
     TriangleSoup soup;
-    constexpr int kAround = 64, kAlong = 24;
-    for (int j = 0; j <= kAlong; ++j)
-        for (int i = 0; i < kAround; ++i) {
-            const double a = 2 * std::numbers::pi * i / kAround;
+    for (int j = 0; j <= along; ++j)
+        for (int i = 0; i < around; ++i) {
+            const double a = 2 * std::numbers::pi * i / around;
             const double r =
-                j == 0 || j == kAlong ? kRadius : kRadius + 0.3 * (2 * rng.uniform() - 1);
+                j == 0 || j == along ? kRadius : kRadius + 0.3 * (2 * rng.uniform() - 1);
             soup.points.push_back(
-                moved(Vec3{r * std::cos(a), r * std::sin(a), kHeight * j / kAlong}));
+                moved(Vec3{r * std::cos(a), r * std::sin(a), kHeight * j / along}));
         }
     const auto at = [&](int i, int j) {
-        return static_cast<std::uint32_t>(j * kAround + i % kAround);
+        return static_cast<std::uint32_t>(j * around + i % around);
     };
-    for (int j = 0; j < kAlong; ++j)
-        for (int i = 0; i < kAround; ++i) {
+    for (int j = 0; j < along; ++j)
+        for (int i = 0; i < around; ++i) {
             soup.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
             soup.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
         }
     const auto bottom = static_cast<std::uint32_t>(soup.points.size());
     soup.points.push_back(moved(Vec3{0, 0, 0}));
     soup.points.push_back(moved(Vec3{0, 0, kHeight}));
-    for (int i = 0; i < kAround; ++i) {
+    for (int i = 0; i < around; ++i) {
         soup.triangles.push_back({bottom, at(i + 1, 0), at(i, 0)});
-        soup.triangles.push_back({bottom + 1, at(i, kAlong), at(i + 1, kAlong)});
+        soup.triangles.push_back({bottom + 1, at(i, along), at(i + 1, along)});
     }
     const Mesh mesh = build_mesh(soup).value().mesh;
     const SolidDeviation dev = brep_detail::measure_deviation(shape, mesh, 0.01);
@@ -116,6 +117,11 @@ TEST(Deviation, TreeDistancesAreTheBruteForceOnes) {
     EXPECT_NEAR(dev.mesh_to_solid.mean, to_solid_mean, 1e-12);
     EXPECT_EQ(dev.solid_to_mesh.max, to_mesh_max);
     EXPECT_NEAR(dev.solid_to_mesh.mean, to_mesh_mean, 1e-12);
+}
+
+TEST(Deviation, TreeDistancesAreTheBruteForceOnes) {
+    expect_brute_force_distances(64, 24);
+    expect_brute_force_distances(256, 36);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <BRepBuilderAPI_MakeVertex.hxx>
 #include <BRepExtrema_DistShapeShape.hxx>
@@ -62,18 +63,27 @@ class TriangleTree {
    public:
     explicit TriangleTree(std::vector<Triangle> tris) : tris_(std::move(tris)) {
         if (tris_.empty()) return;
-        std::vector<Vec3> centre(tris_.size());
-        for (std::size_t i = 0; i < tris_.size(); ++i) {
-            centre[i] = (1.0 / 3) * (tris_[i][0] + tris_[i][1] + tris_[i][2]);
-        }
-        order_.resize(tris_.size());
-        for (std::uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
-        nodes_.reserve(4 * tris_.size() / kLeafTriangles + 1);
-        nodes_.emplace_back();
-        build(0, 0, static_cast<std::uint32_t>(order_.size()), centre);
+        const std::size_t n = tris_.size();
+        std::vector<Vec3> centre(n);
+        order_.resize(n);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const auto& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                centre[i] = (1.0 / 3) * (tris_[i][0] + tris_[i][1] + tris_[i][2]);
+                order_[i] = static_cast<std::uint32_t>(i);
+            }
+        });
+        // Every node's place is known before it is built (nodes_below()): the two halves of a
+        // large range are built at once, into the layout one depth-first pass gives.
+        const auto count = static_cast<std::uint32_t>(n);
+        Memo below;
+        memoize_below(count, below);
+        nodes_.resize(1 + nodes_below(count, below));
+        build(0, 1, 0, count, centre, below);
         // Leaves hold their triangles in tree order: a query reads them one after another.
-        std::vector<Triangle> sorted(tris_.size());
-        for (std::size_t i = 0; i < order_.size(); ++i) sorted[i] = tris_[order_[i]];
+        std::vector<Triangle> sorted(n);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const auto& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) sorted[i] = tris_[order_[i]];
+        });
         tris_ = std::move(sorted);
     }
 
@@ -109,6 +119,11 @@ class TriangleTree {
    private:
     // Triangles per leaf: a few closest-point tests cost less than another level of boxes.
     static constexpr std::uint32_t kLeafTriangles = 4;
+    // Ranges of at least this many triangles build their halves at once (below it a task
+    // costs more than it saves); the tree is the same on any thread count.
+    static constexpr std::uint32_t kParallelBuild = 1u << 14;
+    // Triangles per task of the parallel loops over all of them.
+    static constexpr std::size_t kGrain = 1u << 14;
     struct Node {
         Box3 box;
         std::uint32_t first = 0;  // leaf: first triangle; inner node: first of two children
@@ -124,11 +139,36 @@ class TriangleTree {
         return d2;
     }
 
-    // Node `slot` over order_[begin, end), its two children appended next to each other; its
-    // box the union of theirs. Depth is about log2(n / kLeafTriangles): the median split
-    // halves every range.
-    void build(std::uint32_t slot, std::uint32_t begin, std::uint32_t end,
-               const std::vector<Vec3>& centre) {
+    /// The nodes below the node of a range of `count` triangles (its children, theirs...):
+    /// the median split makes it a function of the count, with at most two counts a level
+    /// (the floor and the ceiling of a half). `memo` holds them sorted by count once
+    /// memoize_below() has filled it; the parallel build only reads it.
+    using Memo = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+    static std::uint32_t nodes_below(std::uint32_t count, const Memo& memo) {
+        if (count <= kLeafTriangles) return 0;
+        const auto it = std::lower_bound(memo.begin(), memo.end(),
+                                         std::pair<std::uint32_t, std::uint32_t>(count, 0));
+        if (it != memo.end() && it->first == count) return it->second;
+        const std::uint32_t half = count / 2;
+        return 2 + nodes_below(half, memo) + nodes_below(count - half, memo);
+    }
+    static void memoize_below(std::uint32_t count, Memo& memo) {
+        if (count <= kLeafTriangles) return;
+        for (const auto& [c, k] : memo)
+            if (c == count) return;
+        const std::uint32_t half = count / 2;
+        memoize_below(half, memo);
+        memoize_below(count - half, memo);
+        memo.emplace_back(count, 2 + nodes_below(half, memo) + nodes_below(count - half, memo));
+        std::sort(memo.begin(), memo.end());
+    }
+
+    // Node `slot` over order_[begin, end), its two children next to each other at `free`,
+    // their subtrees after them, the first's then the second's (as a depth-first pass that
+    // appends them lays them out); its box the union of theirs. Depth is about
+    // log2(n / kLeafTriangles): the median split halves every range.
+    void build(std::uint32_t slot, std::uint32_t free, std::uint32_t begin, std::uint32_t end,
+               const std::vector<Vec3>& centre, const Memo& below) {
         if (end - begin <= kLeafTriangles) {
             Box3 box;
             for (std::uint32_t i = begin; i < end; ++i) {
@@ -154,12 +194,18 @@ class TriangleTree {
                              const double ca = centre[a][axis], cb = centre[b][axis];
                              return ca < cb || (ca == cb && a < b);
                          });
-        const auto left = static_cast<std::uint32_t>(nodes_.size());
-        nodes_.emplace_back();
-        nodes_.emplace_back();
+        const std::uint32_t left = free;
         nodes_[slot].first = left;
-        build(left, begin, mid, centre);
-        build(left + 1, mid, end, centre);
+        const std::uint32_t left_free = left + 2;
+        const std::uint32_t right_free = left_free + nodes_below(mid - begin, below);
+        const auto build_left = [&] { build(left, left_free, begin, mid, centre, below); };
+        const auto build_right = [&] { build(left + 1, right_free, mid, end, centre, below); };
+        if (end - begin >= kParallelBuild) {
+            tbb::parallel_invoke(build_left, build_right);
+        } else {
+            build_left();
+            build_right();
+        }
         Box3 box = nodes_[left].box;
         box.add(nodes_[left + 1].box);
         nodes_[slot].box = box;
