@@ -684,27 +684,54 @@ TEST(FitBSpline, PlanesStayPlanesAndNonHeightFieldsFail) {
     EXPECT_EQ(below.surface.bspline->num_u * below.surface.bspline->num_v, 64 * 64);
 }
 
-// refuse_rms for B-splines: a free-form patch of many points is fitted as it is without, to
-// the bit (its sample's net holds the sample); a whole cylinder, no height field and no open
-// profile, is refused on its sample's nets, and its whole fit fails too; a fit of fewer points
-// than kSampledFitPoints is never sampled.
+// refuse_rms for B-splines, with the limits segmentation's free-form groups set (a net of at
+// most 256 poles, a profile of at most 64, an RMS goal): a free-form patch of many points and a
+// wall extruded along a hairpin profile (18003 points: the extrusion is fitted on them all, not
+// on a sample) are fitted as they are without it, to the bit; a whole cylinder, no height
+// field and no open profile, is refused on its sample's nets, and its whole fit fails too; a
+// fit of fewer points than kSampledFitPoints is never sampled.
 TEST(FitBSpline, ManyPointsOffTheirSampleFitAreRefusedWithoutTheWholeFit) {
+    const auto as_segmentation = [](FitInput in, double tol) {
+        in.max_net_poles = 256;
+        in.max_profile_poles = 64;
+        in.rms_goal = 0.5 * tol;
+        return in;
+    };
+    const auto same = [](const FitResult& a, const FitResult& b) {
+        return a.ok == b.ok && a.rms == b.rms && a.max == b.max && a.surface.bspline &&
+               b.surface.bspline && a.surface.bspline->poles == b.surface.bspline->poles &&
+               a.surface.bspline->extruded == b.surface.bspline->extruded;
+    };
     test::Rng rng(37);
     const Patch p = freeform_patch(rng, 2 * kSampledFitPoints);
     const double tol = 1e-3 * p.size;
-    FitInput in{p.points, p.normals, {}};
+    FitInput in = as_segmentation(FitInput{p.points, p.normals, {}}, tol);
     const FitResult whole = fit_bspline(in, tol);
     ASSERT_TRUE(whole.ok) << whole.failure;
     in.refuse_rms = 3 * tol;
     const FitResult sampled = fit_bspline(in, tol);
     ASSERT_TRUE(sampled.ok) << sampled.failure;
-    EXPECT_EQ(sampled.rms, whole.rms);
-    EXPECT_EQ(sampled.max, whole.max);
-    EXPECT_EQ(sampled.surface.bspline->poles, whole.surface.bspline->poles);
+    EXPECT_TRUE(same(sampled, whole));
+
+    std::vector<Vec3> wall, wall_normals;
+    for (int k = -3000; k <= 3000; ++k) {
+        const double y = 6.0 * k / 3000, x = y * y / 0.5;
+        for (const double z : {0.0, 2.0, 5.0}) {
+            wall.push_back(Vec3{x, y, z});
+            wall_normals.push_back(normalized(Vec3{1, -y / 0.25, 0}));
+        }
+    }
+    ASSERT_GE(wall.size(), kSampledFitPoints);
+    FitInput folded = as_segmentation(FitInput{wall, wall_normals, {}}, 0.01);
+    const FitResult wall_whole = fit_bspline(folded, 0.01);
+    ASSERT_TRUE(wall_whole.ok) << wall_whole.failure;
+    EXPECT_TRUE(wall_whole.surface.bspline->extruded);
+    folded.refuse_rms = 3 * 0.01;
+    EXPECT_TRUE(same(fit_bspline(folded, 0.01), wall_whole));
 
     const Patch tube = cylinder_patch(rng, 5, 360, 20, 2 * kSampledFitPoints);
     const double t = 1e-3 * tube.size;
-    FitInput round{tube.points, tube.normals, {}};
+    FitInput round = as_segmentation(FitInput{tube.points, tube.normals, {}}, t);
     const FitResult tube_whole = fit_bspline(round, t);
     EXPECT_FALSE(tube_whole.ok);
     EXPECT_EQ(tube_whole.failure.find("sample"), std::string::npos) << tube_whole.failure;

@@ -149,9 +149,10 @@ struct FitInput {
     /// the sample's least-squares minimum does no worse: a caller that keeps fits with max <= t
     /// passes a few t, the margin for a fit that stops short of that minimum (a local one, the
     /// iteration cap), and should lose none it keeps (docs/fitting.md: segmentation's study
-    /// unchanged with 3 t). fit_bspline() does the same, refusing also when the sample's
-    /// largest net (or profile) misses by more than this: a net the whole fit would take is
-    /// tried on the sample too, and holds it with that RMS at least.
+    /// unchanged with 3 t). fit_bspline() does the same for its nets (after the extrusion, on
+    /// the whole), refusing also when the sample's largest net misses by more than this: the
+    /// sample tries nets at least as fine as the whole would, one of which holds it with that
+    /// RMS at least.
     double refuse_rms = 0;
 };
 

@@ -2766,20 +2766,6 @@ FitResult with_model(const Surface& s, F&& f) {
 
 FitResult fit_bspline(const FitInput& in, double tolerance) {
     if (std::optional<FitResult> bad = unfit_for_bspline(in)) return *bad;
-    // The sample first (FitInput::refuse_rms). Its best net is refused too when it misses: a
-    // group of pieces half a part's size, far from any height field, took a second of nets
-    // over all its points to find none.
-    const std::size_t n = in.points.size();
-    if (in.refuse_rms > 0 && n >= kSampledFitPoints) {
-        const Strided strided(in, n / kRefuseSamplePoints);
-        FitInput sample = strided.input(in);
-        sample.refuse_rms = 0;
-        const FitResult look = fit_bspline(sample, tolerance);
-        if (look.rms > in.refuse_rms) {
-            return failed(FitKind::kBSpline,
-                          "a sample of the points is off its fit by RMS " + number(look.rms));
-        }
-    }
     // A wall extruded along one direction first: its net is a profile's, not a grid's.
     bool capped = false;
     FitResult extrusion = fit_extrusion(in, tolerance, capped);
@@ -2787,6 +2773,25 @@ FitResult fit_bspline(const FitInput& in, double tolerance) {
     // An extrusion whose profile would need more poles than the caller takes is still one: no
     // net over its mean plane either.
     if (capped) return extrusion;
+    // The nets on a sample first (FitInput::refuse_rms): a group of pieces half a part's size,
+    // far from any height field, took a second of nets over all its points to find none. Not
+    // the extrusion: a sample's normals and profile nodes are not the whole's, and a folded
+    // wall that only the whole's profile holds is no height field. The sample's nets are not
+    // held to the caller's largest: its principal axes, and so its nets' proportions, differ a
+    // little from the whole's, and it should try every net the whole would (more poles only
+    // bring its RMS down).
+    const std::size_t n = in.points.size();
+    if (in.refuse_rms > 0 && n >= kSampledFitPoints) {
+        const Strided strided(in, n / kRefuseSamplePoints);
+        FitInput sample = strided.input(in);
+        sample.refuse_rms = 0;
+        sample.max_net_poles = 0;
+        const FitResult look = fit_bspline_impl(sample, tolerance);
+        if (look.rms > in.refuse_rms) {
+            return failed(FitKind::kBSpline,
+                          "a sample of the points is off its nets by RMS " + number(look.rms));
+        }
+    }
     return fit_bspline_impl(in, tolerance);
 }
 
