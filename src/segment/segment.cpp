@@ -20,6 +20,8 @@
 #include <queue>
 #include <tuple>
 
+#include "detail/huge_pages.h"
+
 namespace ncrev {
 
 const char* to_string(SegmentMethod method) {
@@ -180,10 +182,10 @@ struct FaceData {
 FaceData face_data(const Mesh& m) {
     const std::size_t nf = m.num_faces();
     FaceData d;
-    d.normal.resize(nf);
-    d.centroid.resize(nf);
-    d.area.resize(nf);
-    d.adj.resize(nf);
+    detail::resize_huge(d.normal, nf);
+    detail::resize_huge(d.centroid, nf);
+    detail::resize_huge(d.area, nf);
+    detail::resize_huge(d.adj, nf);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096), [&](const auto& r) {
         for (std::size_t f = r.begin(); f != r.end(); ++f) {
             const FaceId ff = fid(static_cast<std::uint32_t>(f));
@@ -273,7 +275,7 @@ struct Context {
 /// kSagFactor x the kSagQuantile quantile, never below the tolerance. Fills c.facet_sag.
 double estimate_sag(Context& c) {
     const Mesh& m = c.m;
-    c.facet_sag.assign(m.num_faces(), 0.0f);
+    detail::assign_huge(c.facet_sag, m.num_faces(), 0.0f);
     std::vector<double> sags;
     for (std::uint32_t h = 0; h < m.num_halfedges(); ++h) {
         const HalfedgeId he(h);
@@ -535,7 +537,8 @@ struct Draft {
 std::vector<std::vector<std::uint32_t>> smooth_patches(const Context& c,
                                                        const std::vector<std::uint8_t>& mask) {
     const std::size_t nf = c.m.num_faces();
-    std::vector<std::uint32_t> parent(nf);
+    std::vector<std::uint32_t> parent;
+    detail::resize_huge(parent, nf);
     std::iota(parent.begin(), parent.end(), 0u);
     const auto find = [&](std::uint32_t x) {
         while (parent[x] != x) x = parent[x] = parent[parent[x]];
@@ -552,7 +555,8 @@ std::vector<std::vector<std::uint32_t>> smooth_patches(const Context& c,
             if (a != b) parent[std::max(a, b)] = std::min(a, b);
         }
     }
-    std::vector<std::uint32_t> index(nf, kNone);
+    std::vector<std::uint32_t> index;
+    detail::assign_huge(index, nf, kNone);
     std::vector<std::vector<std::uint32_t>> patches;
     for (std::uint32_t f = 0; f < nf; ++f) {
         if (!mask[f]) continue;
@@ -849,7 +853,8 @@ void sort_facets(std::vector<std::uint32_t>& faces) {
 }
 
 std::vector<std::uint32_t> region_of_faces(const Mesh& m, const std::vector<Draft>& drafts) {
-    std::vector<std::uint32_t> region(m.num_faces(), kNone);
+    std::vector<std::uint32_t> region;
+    detail::assign_huge(region, m.num_faces(), kNone);
     for (std::uint32_t r = 0; r < drafts.size(); ++r) {
         if (!drafts[r].alive) continue;
         for (const std::uint32_t f : drafts[r].faces) region[f] = r;
@@ -3333,8 +3338,8 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
     c.cos_normal = std::cos(kSegmentNormalAngle);
     if (progress) progress("segment", 0.0);
     c.fd = face_data(m);
-    c.sharp_edge.assign(m.num_halfedges(), 0);
-    c.edge_turn.assign(m.num_halfedges(), 0.0f);
+    detail::assign_huge(c.sharp_edge, m.num_halfedges(), std::uint8_t{0});
+    detail::assign_huge(c.edge_turn, m.num_halfedges(), 0.0f);
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, m.num_halfedges(), 4096), [&](const auto& r) {
             for (std::size_t h = r.begin(); h != r.end(); ++h) {
@@ -3365,8 +3370,8 @@ SegmentResult run_segment(const Mesh& m, const SegmentOptions& options, double t
         const auto patches = smooth_patches(c, mask);
         result.patches = patches.size();
         const std::size_t nf = m.num_faces();
-        std::vector<std::uint32_t> patch_of(nf, kNone), owner(nf, kNone), queued(nf, kNone),
-            depth(nf, kNone);
+        std::vector<std::uint32_t> patch_of, owner, queued, depth;
+        for (auto* v : {&patch_of, &owner, &queued, &depth}) detail::assign_huge(*v, nf, kNone);
         for (std::uint32_t i = 0; i < patches.size(); ++i)
             for (const std::uint32_t f : patches[i]) patch_of[f] = i;
         std::vector<std::vector<Draft>> grown(patches.size());
