@@ -55,6 +55,11 @@ namespace {
 
 using Triangle = std::array<Vec3, 3>;
 
+/// Triangles per task of the parallel loops over all of a mesh's or a tree's (gathering them,
+/// their centres, the tree's reordered copy): each costs a few nanoseconds there, and a task's
+/// overhead about a microsecond, so tasks this large keep it under a percent.
+constexpr std::uint32_t kGrain = 1u << 14;
+
 // A bounding-volume hierarchy of triangles: boxes split at the median of their triangles'
 // centres along their longest side, down to kLeafTriangles. A nearest-triangle query descends
 // nearer child first and skips every box farther than the best distance found. Unlike a
@@ -128,10 +133,6 @@ class TriangleTree {
     // Ranges of at least this many triangles build their halves at once (below it a task
     // costs more than it saves); the tree is the same on any thread count.
     static constexpr std::uint32_t kParallelBuild = 1u << 14;
-    // Triangles per task of the parallel loops over all of them (the centres, the reordered
-    // copy): each triangle costs a few nanoseconds there, and a task's overhead about a
-    // microsecond, so tasks this large keep it under a percent.
-    static constexpr std::size_t kGrain = 1u << 14;
     struct Node {
         Box3 box;
         std::uint32_t first = 0;  // leaf: first triangle; inner node: first of two children
@@ -227,7 +228,7 @@ class TriangleTree {
 std::vector<Triangle> mesh_triangles(const Mesh& mesh) {
     std::vector<Triangle> tris;
     detail::resize_huge(tris, mesh.num_faces());
-    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, mesh.num_faces(), 1u << 14),
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, mesh.num_faces(), kGrain),
                       [&](const tbb::blocked_range<std::uint32_t>& r) {
                           for (std::uint32_t f = r.begin(); f != r.end(); ++f) {
                               for (int i = 0; i < 3; ++i)

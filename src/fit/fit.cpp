@@ -2707,6 +2707,24 @@ std::string number(double x) {
     return buf;
 }
 
+/// FitInput::refuse_rms, for fit() and fit_bspline(): a fit of kSampledFitPoints points or more
+/// made first on every n-th of them (kRefuseSamplePoints or more) by `look`, which gives the RMS
+/// that may refuse them (none: it does not); the failure of `kind` when it exceeds refuse_rms,
+/// nothing otherwise or when `in` is not sampled.
+template <class Look>
+std::optional<FitResult> refused_on_sample(FitKind kind, const FitInput& in, const char* fitted,
+                                           Look&& look) {
+    const std::size_t n = in.points.size();
+    if (!(in.refuse_rms > 0 && n >= kSampledFitPoints)) return std::nullopt;
+    const Strided strided(in, n / kRefuseSamplePoints);
+    FitInput sample = strided.input(in);
+    sample.refuse_rms = 0;
+    const std::optional<double> rms = look(sample);
+    if (!rms || !(*rms > in.refuse_rms)) return std::nullopt;
+    return failed(kind, std::string("a sample of the points is off its ") + fitted + " by RMS " +
+                            number(*rms));
+}
+
 /// What fit() and refit() ask of every input (matching sizes, finite points, non-negative
 /// weights, points spanning a plane): a failure, or nothing.
 std::optional<FitResult> invalid_input(FitKind kind, const FitInput& in) {
@@ -2780,18 +2798,11 @@ FitResult fit_bspline(const FitInput& in, double tolerance) {
     // held to the caller's largest: its principal axes, and so its nets' proportions, differ a
     // little from the whole's, and it should try every net the whole would (more poles only
     // bring its RMS down).
-    const std::size_t n = in.points.size();
-    if (in.refuse_rms > 0 && n >= kSampledFitPoints) {
-        const Strided strided(in, n / kRefuseSamplePoints);
-        FitInput sample = strided.input(in);
-        sample.refuse_rms = 0;
+    const auto nets = [&](FitInput sample) -> std::optional<double> {
         sample.max_net_poles = 0;
-        const FitResult look = fit_bspline_impl(sample, tolerance);
-        if (look.rms > in.refuse_rms) {
-            return failed(FitKind::kBSpline,
-                          "a sample of the points is off its nets by RMS " + number(look.rms));
-        }
-    }
+        return fit_bspline_impl(sample, tolerance).rms;  // the largest net's when all fail
+    };
+    if (auto refused = refused_on_sample(FitKind::kBSpline, in, "nets", nets)) return *refused;
     return fit_bspline_impl(in, tolerance);
 }
 
@@ -2808,17 +2819,13 @@ FitResult refit(const Surface& start, const FitInput& in) {
 }
 
 FitResult fit(FitKind kind, const FitInput& in) {
-    const std::size_t n = in.points.size();
     if (auto bad = invalid_input(kind, in)) return *bad;
-    // The sample: every step-th point, kRefuseSamplePoints or more (FitInput::refuse_rms).
-    if (refined_kind(kind) && in.refuse_rms > 0 && n >= kSampledFitPoints) {
-        const Strided strided(in, n / kRefuseSamplePoints);
-        FitInput sample = strided.input(in);
-        sample.refuse_rms = 0;
-        const FitResult look = fit(kind, sample);
-        if (look.ok && look.rms > in.refuse_rms) {
-            return failed(kind, "a sample of the points is off its fit by RMS " + number(look.rms));
-        }
+    if (refined_kind(kind)) {
+        const auto one_fit = [&](const FitInput& sample) -> std::optional<double> {
+            const FitResult look = fit(kind, sample);
+            return look.ok ? std::optional<double>(look.rms) : std::nullopt;
+        };
+        if (auto refused = refused_on_sample(kind, in, "fit", one_fit)) return *refused;
     }
     switch (kind) {
         case FitKind::kPlane:
