@@ -183,5 +183,43 @@ BENCHMARK(BM_ReadAndBuildFile)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+// The part's size in every pose (part_size(), the segmentation's tolerance), against the
+// bounding box's diagonal it replaced, on the torus: no planar face, so its three largest
+// facets' directions each give a generic outline to hull.
+const Mesh& torus_mesh(std::size_t facets) {
+    static std::map<std::size_t, Mesh> cache;
+    auto it = cache.find(facets);
+    if (it == cache.end()) it = cache.emplace(facets, build_mesh(torus_soup(facets))->mesh).first;
+    return it->second;
+}
+
+void BM_PartSize(benchmark::State& state) {
+    const Mesh& m = torus_mesh(static_cast<std::size_t>(state.range(0)));
+    for (auto _ : state) benchmark::DoNotOptimize(part_size(m));
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * m.num_faces()));
+}
+BENCHMARK(BM_PartSize)
+    ->Arg(k100k)
+    ->Arg(k1M)
+    ->Arg(k5M)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_BoxDiagonal(benchmark::State& state) {
+    const Mesh& m = torus_mesh(static_cast<std::size_t>(state.range(0)));
+    for (auto _ : state) {
+        Box3 box;
+        for (const Vec3& p : m.positions()) box.add(p);
+        benchmark::DoNotOptimize(box.diagonal());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * m.num_faces()));
+}
+BENCHMARK(BM_BoxDiagonal)
+    ->Arg(k100k)
+    ->Arg(k1M)
+    ->Arg(k5M)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 }  // namespace
 }  // namespace ncrev::bench

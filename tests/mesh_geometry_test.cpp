@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <numbers>
+#include <vector>
 
 #include "ncrev/mesh.h"
 #include "test_meshes.h"
@@ -90,6 +92,77 @@ TEST(MeshGeometry, SphereVertexNormalsAreRadial) {
         EXPECT_GT(dot(n[VertexId(static_cast<std::uint32_t>(v))], radial), 0.9999);
     }
 }
+
+/// A prism of height h over the convex polygon `outline` (counter-clockwise in z = 0), its caps
+/// fans from their first corner, outward.
+test::Indexed prism(const std::vector<Vec3>& outline, double h) {
+    test::Indexed m;
+    const auto n = static_cast<std::uint32_t>(outline.size());
+    for (const Vec3& p : outline) m.points.push_back(p);
+    for (const Vec3& p : outline) m.points.push_back(p + Vec3{0, 0, h});
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const std::uint32_t j = (i + 1) % n;
+        m.triangles.push_back({i, j, n + j});
+        m.triangles.push_back({i, n + j, n + i});
+    }
+    for (std::uint32_t i = 1; i + 1 < n; ++i) {
+        m.triangles.push_back({0, i + 1, i});
+        m.triangles.push_back({n, n + i, n + i + 1});
+    }
+    return m;
+}
+
+double box_diagonal(const Mesh& m) {
+    Box3 box;
+    for (const Vec3& p : m.positions()) box.add(p);
+    return box.diagonal();
+}
+
+TEST(PartSize, ABlockIsItsBoxDiagonalInEveryPose) {
+    const test::Indexed block = prism({{0, 0, 0}, {100, 0, 0}, {100, 60, 0}, {0, 60, 0}}, 20);
+    const Mesh in_axes = build(test::to_indexed_soup(block));
+    const double diagonal = std::sqrt(100.0 * 100 + 60 * 60 + 20 * 20);
+    EXPECT_NEAR(part_size(in_axes), diagonal, 1e-12 * diagonal);
+    TriangleSoup turned = test::to_indexed_soup(block);
+    test::rigid_motion(turned, 0.7, {40, -25, 10});
+    const Mesh moved = build(turned);
+    EXPECT_NEAR(part_size(moved), diagonal, 1e-12 * diagonal);
+    EXPECT_GT(box_diagonal(moved), 1.2 * diagonal);  // what the box alone would say
+}
+
+TEST(PartSize, ATurnedPartsSizeIsItsBoxDiagonalAlongItsAxis) {
+    // A disc of radius 50 and thickness 10 in 64 sides, a vertex on each axis: its box is
+    // 100 x 100 x 10, the smallest with a side along an edge of its outline a hair narrower.
+    std::vector<Vec3> outline;
+    for (int i = 0; i < 64; ++i) {
+        const double a = i * std::numbers::pi / 32;
+        outline.push_back({50 * std::cos(a), 50 * std::sin(a), 0});
+    }
+    const test::Indexed disc = prism(outline, 10);
+    const Mesh in_axes = build(test::to_indexed_soup(disc));
+    const double size = part_size(in_axes);
+    const double across = 100 * std::cos(std::numbers::pi / 64);  // between parallel sides
+    EXPECT_NEAR(size, std::sqrt(2 * across * across + 10 * 10), 1e-9 * size);
+    EXPECT_LE(size, box_diagonal(in_axes));
+    TriangleSoup turned = test::to_indexed_soup(disc);
+    test::rigid_motion(turned, 1.1, {-7, 3, 12});
+    EXPECT_NEAR(part_size(build(turned)), size, 1e-12 * size);
+}
+
+TEST(PartSize, AnLShapedOutlineIsMeasuredAlongItsEdges) {
+    // An L: 80 x 50 overall, arms 20 wide, 30 high; the smallest box is its bounding box.
+    const test::Indexed ell =
+        prism({{0, 0, 0}, {80, 0, 0}, {80, 20, 0}, {20, 20, 0}, {20, 50, 0}, {0, 50, 0}}, 30);
+    // (Its caps are fans from the corner at the origin, which sees every other corner.)
+    const Mesh in_axes = build(test::to_indexed_soup(ell));
+    const double diagonal = std::sqrt(80.0 * 80 + 50 * 50 + 30 * 30);
+    EXPECT_NEAR(part_size(in_axes), diagonal, 1e-12 * diagonal);
+    TriangleSoup turned = test::to_indexed_soup(ell);
+    test::rigid_motion(turned, 2.3, {0, 0, 0});
+    EXPECT_NEAR(part_size(build(turned)), diagonal, 1e-12 * diagonal);
+}
+
+TEST(PartSize, AnEmptyMeshHasNone) { EXPECT_EQ(part_size(Mesh{}), 0.0); }
 
 }  // namespace
 }  // namespace ncrev

@@ -1163,6 +1163,10 @@ TEST(ReverseSurfaces, WideDraftedWallsTakeTheirFacets) {
 // (their RMS above 0.01 deflections: no exact face) now join it while one B-spline refitted to
 // them holds their vertices within the deflection and their facets' middles within it too
 // (widen_freeform()): 59 -> 54 faces, the solid 1.94 -> 1.70 deflections from the mesh at most.
+// Then 5 -> 6 fallbacks (54 faces, 1.70 -> 1.91 deflections) when the tolerance followed the
+// part's size in every pose (part_size(): 0.24 % smaller here): this part's count swings with
+// the tolerance, 42-60 faces and 4-8 fallbacks within 2 % of it either way (its STL, `reverse
+// --tolerance`, the build before).
 TEST(ReverseSurfaces, TangentJunctionsOfFittedPiecesHaveEdges) {
     const auto path = corpus_step_dir() / "occt_linkrods.step";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
@@ -1173,7 +1177,7 @@ TEST(ReverseSurfaces, TangentJunctionsOfFittedPiecesHaveEdges) {
     EXPECT_LE(lone, 12u);
     expect_solid(o, "linkrods");
     EXPECT_LE(o.report.faces, 54u);
-    EXPECT_LE(o.report.fallbacks.size(), 5u);
+    EXPECT_LE(o.report.fallbacks.size(), 6u);
     expect_near_the_part(o, "linkrods");
 }
 

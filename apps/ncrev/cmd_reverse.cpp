@@ -63,8 +63,9 @@ void add_reverse(CLI::App& app, Context& ctx) {
                     "'region' and 'red green blue'), as `ncrev segment` does");
     cmd->add_option("--tolerance", o->tolerance,
                     "auto/surfaces: largest distance of a vertex from its region's surface, in "
-                    "the file's unit (default: 1e-4 x the bounding-box diagonal, raised to the "
-                    "noise of a noisy mesh)")
+                    "the file's unit (default: 1e-4 x the part's size, the diagonal of its "
+                    "smallest box, the same in every pose; raised to the noise of a "
+                    "noisy mesh)")
         ->check(kPositive);
     cmd->add_flag("--no-surface-indices", o->no_surfaces,
                   "Segment every facet, ignoring the surface indices of an SRE file");

@@ -49,8 +49,8 @@ void add_segment(CLI::App& app, Context& ctx) {
                     "(-1 for a facet that healing removed)");
     cmd->add_option("--tolerance", o->segment.tolerance,
                     "Largest distance of a vertex from its region's surface, in the file's unit "
-                    "(default: 1e-4 x the bounding-box diagonal, raised to six times the noise of "
-                    "a noisy mesh)")
+                    "(default: 1e-4 x the part's size, the diagonal of its smallest box, the same "
+                    "in every pose; raised to six times the noise of a noisy mesh)")
         ->check(kPositive);
     cmd->add_option("--sharp-angle", o->sharp_degrees,
                     "Dihedral angle in degrees from which an edge is sharp (default " +

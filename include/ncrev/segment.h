@@ -35,8 +35,8 @@ enum class SegmentMethod { kFacets, kPaper };
 /// "facets", "paper".
 const char* to_string(SegmentMethod method);
 
-/// Default tolerance as a fraction of the bounding-box diagonal: 0.01 mm on a 100 mm part, a
-/// tenth of a general machining tolerance. The vertices of a CAD tessellation lie on the
+/// Default tolerance as a fraction of the part's size (part_size()): 0.01 mm on a 100 mm
+/// part, a tenth of a general machining tolerance. The vertices of a CAD tessellation lie on the
 /// surface they sample to float rounding (`ncrev segment PART.sre --json`: every given
 /// surface's max residual is 0); vertices further than this from a region's surface belong to
 /// another surface. A noisy mesh raises it (segment()).

@@ -107,8 +107,9 @@ ShapeType classify_shape(double k1, double k2, double planar_curvedness) {
 
 namespace {
 
-/// Curvature radii above this multiple of the model's bounding-box diagonal are planar: such a
-/// surface deviates from its tangent plane by less than diagonal / 800 across the whole part.
+/// Curvature radii above this multiple of the model's size (part_size(), the same in every
+/// pose) are planar: such a surface deviates from its tangent plane by less than size /
+/// 800 across the whole part.
 constexpr double kPlanarRadiusFactor = 100.0;
 /// Noise floor of the estimator on a plane whose coordinates were rounded to a precision eps:
 /// the normals of facets with edges of length l tilt by up to about 2 eps / l, which the
@@ -666,10 +667,9 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
             data[v] = vertex_pass(m, fd, VertexId(static_cast<std::uint32_t>(v)));
     });
 
-    // Bounding box, largest |coordinate|, and whether every coordinate is a float32 (min, max
-    // and "and" are exact, so the parallel reduction is deterministic).
+    // Largest |coordinate|, and whether every coordinate is a float32 (max and "and" are
+    // exact, so the parallel reduction is deterministic).
     struct Extent {
-        Box3 box;
         double max_abs = 0;
         bool all_float = true;
     };
@@ -679,7 +679,6 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
         [&](const auto& r, Extent e) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 const Vec3 p = positions[i];
-                e.box.add(p);
                 for (int k = 0; k < 3; ++k) {
                     e.max_abs = std::max(e.max_abs, std::fabs(p[k]));
                     e.all_float &= static_cast<double>(static_cast<float>(p[k])) == p[k];
@@ -688,12 +687,11 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
             return e;
         },
         [](Extent a, const Extent& b) {
-            a.box.add(b.box);
             a.max_abs = std::max(a.max_abs, b.max_abs);
             a.all_float = a.all_float && b.all_float;
             return a;
         });
-    const double diagonal = ext.box.empty() ? 0.0 : norm(ext.box.max - ext.box.min);
+    const double size = part_size(m);
     // The rounding unit of the coordinates: float32's when every coordinate is a float (binary
     // STL, or text written from floats), else double's.
     th.coordinate_precision = ext.max_abs * (ext.all_float ? 0x1.0p-24 : 0x1.0p-53);
@@ -702,13 +700,13 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
         th.planar_curvedness = options.planar_curvedness;
         th.planar_rule = "given";
     } else {
-        const double by_size = diagonal > 0 ? 1.0 / (kPlanarRadiusFactor * diagonal) : 0.0;
+        const double by_size = size > 0 ? 1.0 / (kPlanarRadiusFactor * size) : 0.0;
         const double l = th.median_edge_length;
         const double by_noise = l > 0 ? kNoiseFloorFactor * th.coordinate_precision / (l * l) : 0;
         th.planar_curvedness = std::max(by_size, by_noise);
         th.planar_rule = by_size >= by_noise
-                             ? "1 / (100 x bounding-box diagonal): radii beyond 100 times the "
-                               "part's size are planes"
+                             ? "1 / (100 x the part's size, the diagonal of its smallest box): "
+                               "radii beyond 100 times the part's size are planes"
                              : "4 x coordinate precision / median edge length^2: the noise "
                                "floor of the rounded coordinates";
     }
