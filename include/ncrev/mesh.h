@@ -219,14 +219,14 @@ VertexMap<double> mixed_voronoi_areas(const Mesh& mesh);
 VertexMap<Vec3> vertex_normals(const Mesh& mesh);
 
 /// The part's size, the same in every pose: the diagonal of the smallest box round it with an
-/// axis along one of the kPartSizeAxes directions its largest facets face most (the
-/// kPartSizeFacets largest; either sense, within kSameDirection) and another along an edge of
-/// its outline seen that way. Its bounding box's diagonal is not the same: turned out of its
-/// axes, a part's box is up to sqrt(3) times as long across (NIST FTC 08's AP242 mesh turned by
-/// 0.7 rad about (1, 2, 3): 1.38 times), and tolerances that followed it segmented the same
-/// part differently. A part in its axes with a face along one of them whose outline has an edge
-/// along another (a block, a plate, a turned part's end face) has its bounding-box diagonal for
-/// its size. A mesh without area gives its bounding-box diagonal.
+/// axis along one of the three directions its 1024 largest facets face most (either sense;
+/// normals within 1e-5 rad are one direction) and another along an edge of its outline seen
+/// that way (convex hull, rotating calipers). Its bounding box's diagonal is not the same: turned
+/// out of its axes, a part's box is up to sqrt(3) times as long across (NIST FTC 08's AP242 mesh
+/// turned by 0.7 rad about (1, 2, 3): 1.38 times), and tolerances that followed it segmented the
+/// same part differently. A block or a plate in its axes has its bounding-box diagonal for its
+/// size, a turned part about that (its outline's polygon is measured along a side). A mesh without
+/// area gives its bounding-box diagonal.
 double part_size(const Mesh& mesh);
 
 /// The default weld tolerance for points whose bounding box is `box`, and its rule in words.
