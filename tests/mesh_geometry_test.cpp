@@ -162,6 +162,49 @@ TEST(PartSize, AnLShapedOutlineIsMeasuredAlongItsEdges) {
     EXPECT_NEAR(part_size(build(turned)), diagonal, 1e-12 * diagonal);
 }
 
+TEST(PartSize, ADenselyMeshedBlockIsMeasuredOnAllCores) {
+    // A 100 x 60 x 20 block, each face a grid of 120 x 120 squares: 86k vertices, more than
+    // one task's share of the passes over the points.
+    TriangleSoup soup;
+    const Vec3 size{100, 60, 20};
+    constexpr int kCells = 120;
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const double side : {0.0, 1.0}) {
+            const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+            const auto corner = [&](int i, int j) {
+                Vec3 p;
+                p[axis] = side * size[axis];
+                p[a] = size[a] * i / kCells;
+                p[b] = size[b] * j / kCells;
+                return p;
+            };
+            for (int i = 0; i < kCells; ++i) {
+                for (int j = 0; j < kCells; ++j) {
+                    const auto n = static_cast<std::uint32_t>(soup.points.size());
+                    soup.points.push_back(corner(i, j));
+                    soup.points.push_back(corner(i + 1, j));
+                    soup.points.push_back(corner(i + 1, j + 1));
+                    soup.points.push_back(corner(i, j + 1));
+                    // Outward: (a, b, axis) is right-handed, the far side faces +axis.
+                    if (side > 0) {
+                        soup.triangles.push_back({n, n + 1, n + 2});
+                        soup.triangles.push_back({n, n + 2, n + 3});
+                    } else {
+                        soup.triangles.push_back({n, n + 2, n + 1});
+                        soup.triangles.push_back({n, n + 3, n + 2});
+                    }
+                }
+            }
+        }
+    }
+    test::rigid_motion(soup, 0.7, {40, -25, 10});
+    const Mesh m = build(soup);
+    ASSERT_GT(m.num_vertices(), 65536u);
+    const double diagonal = std::sqrt(100.0 * 100 + 60 * 60 + 20 * 20);
+    EXPECT_NEAR(part_size(m), diagonal, 1e-12 * diagonal);
+    EXPECT_GT(box_diagonal(m), 1.2 * diagonal);
+}
+
 TEST(PartSize, AnEmptyMeshHasNone) { EXPECT_EQ(part_size(Mesh{}), 0.0); }
 
 }  // namespace

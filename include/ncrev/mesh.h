@@ -226,7 +226,10 @@ VertexMap<Vec3> vertex_normals(const Mesh& mesh);
 /// turned by 0.7 rad about (1, 2, 3): 1.38 times), and tolerances that followed it segmented the
 /// same part differently. A block or a plate in its axes has its bounding-box diagonal for its
 /// size, a turned part about that (its outline's polygon is measured along a side). A mesh without
-/// area gives its bounding-box diagonal.
+/// area gives its bounding-box diagonal. Same in every pose to about 1e-9 of it, where the
+/// directions are the same: facets of equal area (a surface of revolution's) that the cut at
+/// 1024 or at three directions parts may be parted otherwise in another pose by rounding (a
+/// round part's directions all give one box; a part's large planar faces are not parted).
 double part_size(const Mesh& mesh);
 
 /// The default weld tolerance for points whose bounding box is `box`, and its rule in words.

@@ -78,7 +78,11 @@ std::vector<P2> convex_hull(std::vector<P2> p) {
             const double out = std::hypot(next.x - cur.x, next.y - cur.y);
             const double turn =
                 (cur.x - prev.x) * (next.y - cur.y) - (cur.y - prev.y) * (next.x - cur.x);
-            if (in <= kHullSlack * extent || turn <= kHullSlack * in * out) {
+            const double ahead =
+                (cur.x - prev.x) * (next.x - cur.x) + (cur.y - prev.y) * (next.y - cur.y);
+            // Straight on to rounding: the sine small and the outline going on, not back (the
+            // tip of a needle turns by nearly pi, its sine as small).
+            if (in <= kHullSlack * extent || (turn <= kHullSlack * in * out && ahead > 0)) {
                 dropped = true;
                 continue;
             }
@@ -148,9 +152,9 @@ double box_diagonal2_along(std::span<const Vec3> points, Vec3 axis) {
     // Extreme along each direction: the farthest, the first in the points' order of those as
     // far (the same whatever the threads).
     struct Extremes {
-        std::array<double, kFilter> reach;
-        std::array<P2, kFilter> at;
-        std::array<std::size_t, kFilter> index;
+        std::array<double, kFilter> reach{};
+        std::array<P2, kFilter> at{};
+        std::array<std::size_t, kFilter> index{};
         double lo = std::numeric_limits<double>::infinity();
         double hi = -std::numeric_limits<double>::infinity();
         Extremes() { reach.fill(-std::numeric_limits<double>::infinity()); }
