@@ -247,25 +247,34 @@ double part_size(const Mesh& m) {
     const std::size_t nf = m.num_faces();
     // The facets of most area (twice the area; ties by index), then their normals' directions,
     // either sense, with the area of each.
-    // A heap of the largest so far, smallest on top: most facets are refused by one
-    // comparison, and nothing the size of the mesh is allocated.
-    const auto larger = [](const std::pair<double, std::uint32_t>& a,
-                           const std::pair<double, std::uint32_t>& b) {
+    // Per task, a heap of its largest so far, smallest on top (most facets are refused by one
+    // comparison, and nothing the size of the mesh is allocated); then the tasks' best in one
+    // order: area, then index (the same whatever the threads).
+    using Scored = std::pair<double, std::uint32_t>;
+    const auto larger = [](const Scored& a, const Scored& b) {
         return a.first != b.first ? a.first > b.first : a.second < b.second;
     };
-    std::vector<std::pair<double, std::uint32_t>> facets;
-    facets.reserve(std::min(nf, kPartSizeFacets) + 1);
-    for (std::uint32_t f = 0; f < nf; ++f) {
-        const std::pair<double, std::uint32_t> a{norm(m.face_normal_area2(FaceId(f))), f};
-        if (facets.size() == kPartSizeFacets && !larger(a, facets.front())) continue;
-        facets.push_back(a);
-        std::push_heap(facets.begin(), facets.end(), larger);
-        if (facets.size() > kPartSizeFacets) {
-            std::pop_heap(facets.begin(), facets.end(), larger);
-            facets.pop_back();
+    const std::size_t chunks = (nf + kPointGrain - 1) / kPointGrain;
+    std::vector<std::vector<Scored>> best_of(chunks);
+    tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+        std::vector<Scored>& heap = best_of[c];
+        const std::size_t end = std::min(nf, (c + 1) * kPointGrain);
+        for (std::size_t f = c * kPointGrain; f < end; ++f) {
+            const auto id = static_cast<std::uint32_t>(f);
+            const Scored a{norm(m.face_normal_area2(FaceId(id))), id};
+            if (heap.size() == kPartSizeFacets && !larger(a, heap.front())) continue;
+            heap.push_back(a);
+            std::push_heap(heap.begin(), heap.end(), larger);
+            if (heap.size() > kPartSizeFacets) {
+                std::pop_heap(heap.begin(), heap.end(), larger);
+                heap.pop_back();
+            }
         }
-    }
+    });
+    std::vector<Scored> facets;
+    for (const std::vector<Scored>& h : best_of) facets.insert(facets.end(), h.begin(), h.end());
     std::sort(facets.begin(), facets.end(), larger);
+    if (facets.size() > kPartSizeFacets) facets.resize(kPartSizeFacets);
     const std::size_t top = facets.size();
     struct Direction {
         Vec3 n;
