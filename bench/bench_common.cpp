@@ -82,6 +82,15 @@ const TriangleSoup& torus_soup(std::size_t facets) {
     return cache.emplace(facets, std::move(s)).first->second;
 }
 
+const Mesh& torus_mesh(std::size_t facets) {
+    static std::map<std::size_t, Mesh> cache;
+    auto it = cache.find(facets);
+    if (it == cache.end()) {
+        it = cache.emplace(facets, build_mesh(torus_soup(facets)).value().mesh).first;
+    }
+    return it->second;
+}
+
 const TriangleSoup& box_grid_soup(std::size_t facets) {
     static std::map<std::size_t, TriangleSoup> cache;
     auto it = cache.find(facets);

@@ -10,12 +10,15 @@
 #include <vector>
 
 #include "ncrev/io.h"
+#include "ncrev/mesh.h"
 
 namespace ncrev::bench {
 
 /// A closed torus grid (R = 60 mm, r = 25 mm) with about `facets` facets (2·nu·nv), written
 /// facet by facet as a CAD exporter does. Cached.
 const TriangleSoup& torus_soup(std::size_t facets);
+/// That torus built into a mesh (build_mesh() with its defaults). Cached.
+const Mesh& torus_mesh(std::size_t facets);
 /// A prismatic part: a 100 x 60 x 40 mm box whose six faces are each a grid of n x n quads
 /// (about `facets` facets), as a fine simulator mesh of a planar part is. Cached.
 const TriangleSoup& box_grid_soup(std::size_t facets);

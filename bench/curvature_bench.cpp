@@ -3,7 +3,6 @@
 // and 2-ring ones.
 #include <tbb/global_control.h>
 
-#include <map>
 
 #include "bench_common.h"
 #include "ncrev/curvature.h"
@@ -13,15 +12,6 @@ namespace ncrev::bench {
 namespace {
 
 constexpr std::size_t k100k = 100'000, k1M = 1'000'000, k5M = 5'000'000;
-
-const Mesh& torus_mesh(std::size_t facets) {
-    static std::map<std::size_t, Mesh> cache;
-    auto it = cache.find(facets);
-    if (it == cache.end()) {
-        it = cache.emplace(facets, build_mesh(torus_soup(facets)).value().mesh).first;
-    }
-    return it->second;
-}
 
 void run(benchmark::State& state, const CurvatureOptions& options) {
     const Mesh& mesh = torus_mesh(static_cast<std::size_t>(state.range(0)));

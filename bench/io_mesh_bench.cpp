@@ -186,13 +186,6 @@ BENCHMARK(BM_ReadAndBuildFile)
 // The part's size in every pose (part_size(), the segmentation's tolerance), against the
 // bounding box's diagonal it replaced, on the torus: no planar face, so its three largest
 // facets' directions each give a generic outline to hull.
-const Mesh& torus_mesh(std::size_t facets) {
-    static std::map<std::size_t, Mesh> cache;
-    auto it = cache.find(facets);
-    if (it == cache.end()) it = cache.emplace(facets, build_mesh(torus_soup(facets))->mesh).first;
-    return it->second;
-}
-
 void BM_PartSize(benchmark::State& state) {
     const Mesh& m = torus_mesh(static_cast<std::size_t>(state.range(0)));
     for (auto _ : state) benchmark::DoNotOptimize(part_size(m));

@@ -33,6 +33,11 @@ constexpr std::size_t kPartSizeAxes = 3;
 // Points per task in the passes over them.
 constexpr std::size_t kPointGrain = 1 << 16;
 
+// box_diagonal2_along(): the share of the squared radius of the circle its fence's edges clear
+// within which a point needs no edge test (a tenth of a percent short of the radius: rounding
+// keeps no point that near an edge).
+constexpr double kClearShare = 0.998;
+
 // convex_hull(): corners nearer than this share of the hull's extent to the one before, or
 // turning by less than this angle (rad), are not corners: rounding, not shape.
 constexpr double kHullSlack = 1e-9;
@@ -193,7 +198,7 @@ double box_diagonal2_along(std::span<const Vec3> points, Vec3 axis) {
            fence.back().y == fence.front().y)
         fence.pop_back();
     // Most points lie well inside: those within the circle the fence's edges clear round
-    // the mean of its corners (a tenth of a percent short) need no edge test.
+    // the mean of its corners (kClearShare of it) need no edge test.
     P2 mid{0, 0};
     double clear2 = 0;
     if (fence.size() >= 3) {
@@ -206,7 +211,7 @@ double box_diagonal2_along(std::span<const Vec3> points, Vec3 axis) {
             const double c = cross2(a, b, mid);  // positive: mid is inside
             clear2 = std::min(clear2, c > 0 ? c * c / len2 : 0.0);
         }
-        clear2 *= 0.998;
+        clear2 *= kClearShare;
     }
     // Per fence edge, kHullSlack x its length x the fence's extent: the cross product of a point
     // on the edge's line to rounding.
@@ -228,7 +233,7 @@ double box_diagonal2_along(std::span<const Vec3> points, Vec3 axis) {
             if ((q.x - mid.x) * (q.x - mid.x) + (q.y - mid.y) * (q.y - mid.y) < clear2) continue;
             // On a fence's edge or within rounding of it is inside too: no corner of the hull
             // but the fence's own (added below), which a part's straight outline (a torus seen
-            // from its side: 473k of 2.5M points along two lines) would fill with points.
+            // from its side: its tube's top and bottom circles) would fill with points.
             bool inside = fence.size() >= 3;
             for (std::size_t k = 0; inside && k < fence.size(); ++k)
                 inside = cross2(fence[k], fence[(k + 1) % fence.size()], q) > -slack[k];
@@ -246,10 +251,9 @@ double box_diagonal2_along(std::span<const Vec3> points, Vec3 axis) {
 double part_size(const Mesh& m) {
     const std::size_t nf = m.num_faces();
     // The facets of most area (twice the area; ties by index), then their normals' directions,
-    // either sense, with the area of each.
-    // Per task, a heap of its largest so far, smallest on top (most facets are refused by one
-    // comparison, and nothing the size of the mesh is allocated); then the tasks' best in one
-    // order: area, then index (the same whatever the threads).
+    // either sense, with the area of each. Per task, a heap of its largest so far, smallest on top
+    // (most facets are refused by one comparison, and nothing the size of the mesh is allocated);
+    // then the tasks' best in one order: area, then index (the same whatever the threads).
     using Scored = std::pair<double, std::uint32_t>;
     const auto larger = [](const Scored& a, const Scored& b) {
         return a.first != b.first ? a.first > b.first : a.second < b.second;
