@@ -3,7 +3,6 @@
 // and 2-ring ones.
 #include <tbb/global_control.h>
 
-
 #include "bench_common.h"
 #include "ncrev/curvature.h"
 #include "ncrev/mesh.h"
