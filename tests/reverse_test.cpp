@@ -30,11 +30,14 @@
 #include <XCAFDoc_ShapeTool.hxx>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <gp_Pnt.hxx>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -700,6 +703,34 @@ TEST(ReverseSurfaces, CornersOfFourSurfacesAreOneVertex) {
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
     const Outcome o = reverse_part(corpus_part(path), false, ReverseMethod::kAuto, "ctc04");
     expect_exact(o, "ctc04");
+}
+
+// The same part with every coordinate moved by at most one float32 unit (up, down or not, by its
+// own bits): rounding that any file can carry. Each countersunk hole's two circles then had their
+// vertices at other places round the hole, and the face fix, adding a seam from the one to the
+// other, split each loop there: where its own vertex already was, into the circle and a piece of
+// no length from that vertex back to it. BRepCheck passes that, but a STEP file gives an edge
+// its curve and ends only, and reading it back made the piece a whole circle: a hole's cylinder
+// and another's cone failed once read back and fell back to mesh edges (four faces with the
+// coordinates nudged otherwise). Such a face now fails as it is built, and takes a seam of its
+// own between its loops' vertices: no fallback.
+TEST(ReverseSurfaces, NoEdgeClosesOnItsVertexWithNoLength) {
+    const auto path = corpus_step_dir() / "nist_ctc_04_asme1_rd.stp";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    SamplePart part = corpus_part(path);
+    for (Vec3& p : part.mesh.points) {
+        for (int k = 0; k < 3; ++k) {
+            const auto x = static_cast<float>(p[k]);
+            std::uint32_t bits = 0;
+            std::memcpy(&bits, &x, sizeof bits);
+            const int step = static_cast<int>((bits * 2654435761u) >> 30) % 3 - 1;
+            p[k] = step == 0 ? x : std::nextafter(x, step * std::numeric_limits<float>::infinity());
+        }
+    }
+    const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "ctc04_nudged");
+    expect_solid(o, "ctc04_nudged");
+    for (const ReverseFallback& f : o.report.fallbacks)
+        ADD_FAILURE() << f.region << " (" << f.kind << "): " << f.reason;
 }
 
 // The M6 screw's thread (~270 regions of cones, tori and planes along a helix): the face of

@@ -30,6 +30,7 @@
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <ElSLib.hxx>
+#include <GCPnts_AbscissaPoint.hxx>
 #include <Geom2d_Line.hxx>
 #include <GeomAPI_IntSS.hxx>
 #include <GeomAPI_Interpolate.hxx>
@@ -149,6 +150,30 @@ constexpr const char* kUntriangulated = "BRepMesh cannot triangulate its face";
 gp_Pnt pnt(Vec3 v) { return {v.x, v.y, v.z}; }
 Vec3 vec(const gp_Pnt& p) { return {p.X(), p.Y(), p.Z()}; }
 Vec3 vec(const gp_Vec& p) { return {p.X(), p.Y(), p.Z()}; }
+
+// Why a face with an edge from a vertex back to it, no longer than that vertex's tolerance
+// ball is across, fails. It passes BRepCheck, but a STEP file gives an edge only its curve and its
+// two ends: one whose ends are the same vertex on a closed curve is read as the whole curve. The
+// face fix puts such a piece on a band's loop where it splits the loop at the seam it adds and the
+// loop's own vertex is already there (NIST CTC 04's countersunk holes, their mesh's vertices
+// moved by one float32 unit: each loop's vertex elsewhere round the hole, and two to four faces
+// read back with two whole circles for one). It fails as a face that crossed itself does: a
+// band first takes a seam of its own (seamed_band()), which splits no loop.
+constexpr const char* kNoLengthLoop = "an edge of its face closes on its vertex with no length";
+
+// Whether `face` has such an edge.
+bool has_no_length_loop(const TopoDS_Face& face) {
+    for (TopExp_Explorer x(face, TopAbs_EDGE); x.More(); x.Next()) {
+        const TopoDS_Edge e = TopoDS::Edge(x.Current());
+        if (BRep_Tool::Degenerated(e)) continue;
+        TopoDS_Vertex a, b;
+        TopExp::Vertices(e, a, b);
+        if (a.IsNull() || !a.IsSame(b)) continue;
+        BRepAdaptor_Curve c(e);
+        if (GCPnts_AbscissaPoint::Length(c) <= 2 * BRep_Tool::Tolerance(a)) return true;
+    }
+    return false;
+}
 
 Vec3 any_perpendicular(Vec3 a) {
     const Vec3 t = std::abs(a.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
@@ -2901,6 +2926,10 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             try {
                 if (std::string why = check_failure(fc.copy); !why.empty()) {
                     fc.failure = "its face fails OpenCASCADE's check (" + why + ")";
+                    return;
+                }
+                if (has_no_length_loop(TopoDS::Face(fc.copy))) {
+                    fc.failure = kNoLengthLoop;
                     return;
                 }
                 if (opt.mesh_deflection > 0) {
