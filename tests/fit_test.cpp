@@ -1235,6 +1235,30 @@ TEST(Fit, ManyPointsOffTheirSampleFitAreRefusedWithoutTheWholeFit) {
 // radii by a thousandth of themselves, as a region's surface before its border moved) to the
 // same least-squares minimum as fit(); a plane is fitted as by fit(); a start that is no finite
 // surface fails cleanly.
+// A plane's noisy points refitted from a cone flat to 1e-7 rad with its apex among them (what a
+// 42-facet region of occt_TR12J's mesh, nudged by one float32 unit, became; its face fell back
+// to facets): no cone, since the plane holds them as well. A shallow cone of 80 degrees is one.
+TEST(Fit, AFlatConeIsNoCone) {
+    test::Rng rng(31);
+    Patch p = plane_patch(rng, 2000);
+    add_noise(p, 0.05, rng);
+    const FitInput in{p.points, p.normals, {}};
+    Surface flat;
+    flat.kind = FitKind::kCone;
+    flat.axis = p.truth.axis;
+    flat.angle = kPi / 2 - 1e-7;
+    flat.radius = 20;
+    flat.point = p.truth.point + (flat.radius / std::tan(flat.angle)) * flat.axis;
+    const FitResult r = refit(flat, in);
+    EXPECT_FALSE(r.ok);
+    EXPECT_NE(r.failure.find("flat"), std::string::npos) << r.failure;
+    EXPECT_TRUE(fit(FitKind::kPlane, in).ok);
+    const Patch shallow = cone_patch(rng, 10, 80, 360, 2, 2000);
+    const FitResult c = fit(FitKind::kCone, FitInput{shallow.points, shallow.normals, {}});
+    ASSERT_TRUE(c.ok) << c.failure;
+    EXPECT_NEAR(c.surface.angle, 80 * kDeg, 1e-9);
+}
+
 TEST(Fit, RefitFromANearbySurfaceReachesTheFit) {
     test::Rng rng(23);
     for (Patch p : target_patches(rng, 4000)) {

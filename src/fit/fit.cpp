@@ -929,17 +929,23 @@ constexpr double kWideNormals = 0.2;
 /// strips of the test), or pass through all of them with normals across the given ones.
 constexpr double kCloseFit = 1e-3;
 
+/// The points' extent as twice the farthest from their centroid: the same however they are
+/// turned (a bounding box's diagonal is not).
+double turning_extent(const FitInput& in) {
+    const Vec3 g = centroid(in);
+    double reach = 0;
+    for (const Vec3& p : in.points) reach = std::max(reach, norm(p - g));
+    return 2 * reach;
+}
+
 /// The first start's fit stands (no second start): it agrees with the normals, and they turn
 /// widely or it passes within the caller's `accept` or kCloseFit of the extent of every point.
 bool first_fit_stands(const FitResult& res, double spread, const FitInput& in) {
     if (!res.ok || normal_agreement(res.surface, in) < kMinNormalAgreement) return false;
     if (spread >= kWideNormals || res.max <= in.accept) return true;
-    // The extent as twice the farthest point from the centroid: the same however the points
-    // are turned (a bounding box is not, and the choice must not be).
-    const Vec3 g = centroid(in);
-    double reach = 0;
-    for (const Vec3& p : in.points) reach = std::max(reach, norm(p - g));
-    return res.max <= kCloseFit * 2 * reach;
+    // The extent the same however the points are turned (a bounding box's is not, and the
+    // choice must not be).
+    return res.max <= kCloseFit * turning_extent(in);
 }
 
 /// The cylinder along unit d through the points: its radius and axis point from the circle
@@ -1037,6 +1043,16 @@ FitResult refine_cone(ConeModel& m, const FitInput& in) {
     if (res.ok && m.r < 0) {
         res.ok = false;
         res.failure = "the points lie across the apex";
+    }
+    // A cone that leaves the plane through its apex by less, across the points, than its points
+    // leave it is that plane as far as they tell: nothing a machinist would name a cone, and
+    // its apex, which can lie among the points, makes a face on it degenerate (occt_TR12J's
+    // mesh with its coordinates nudged by one float32 unit: a 42-facet region 0.26 mm off a cone
+    // of half-angle pi/2 - 8e-8 through the middle of it, whose face, curves half round the apex
+    // on a 1.4 mm edge, failed as its surface, as its mesh edges, and fell back to facets).
+    if (res.ok && turning_extent(in) / std::tan(m.alpha) <= res.max) {
+        res.ok = false;
+        res.failure = "the cone is flat: a plane within its residual";
     }
     return res;
 }
