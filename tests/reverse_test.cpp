@@ -733,6 +733,28 @@ TEST(ReverseSurfaces, NoEdgeClosesOnItsVertexWithNoLength) {
         ADD_FAILURE() << f.region << " (" << f.kind << "): " << f.reason;
 }
 
+// NIST FTC 07 as an ASCII STL written with six significant digits carries it: every coordinate
+// rounded so. Six faces, a sphere's cap among them, then failed once read back, each with a loop
+// split where its own vertex was (above). A sphere's cap is no band: the fix's seam runs from
+// its loop to the pole, and the surface is now turned about its axis to put that seam
+// elsewhere: no fallback.
+TEST(ReverseSurfaces, ACapsSeamIsTurnedOffItsLoopsVertex) {
+    const auto path = corpus_step_dir() / "nist_ftc_07_asme1_rd.stp";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    SamplePart part = corpus_part(path);
+    for (Vec3& p : part.mesh.points) {
+        for (int k = 0; k < 3; ++k) {
+            char text[32];
+            std::snprintf(text, sizeof text, "%.5e", static_cast<double>(static_cast<float>(p[k])));
+            p[k] = static_cast<float>(std::strtod(text, nullptr));
+        }
+    }
+    const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "ftc07_six_digits");
+    expect_solid(o, "ftc07_six_digits");
+    for (const ReverseFallback& f : o.report.fallbacks)
+        ADD_FAILURE() << f.region << " (" << f.kind << "): " << f.reason;
+}
+
 // The M6 screw's thread (~270 regions of cones, tori and planes along a helix): the face of
 // its threaded core kept 11 of its 158 edges after ShapeFix_Face dropped a wire it found
 // outside the surface's bounds; that face passed its check, its neighbours' edges stayed

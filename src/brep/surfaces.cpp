@@ -43,6 +43,7 @@
 #include <Geom_Circle.hxx>
 #include <Geom_ConicalSurface.hxx>
 #include <Geom_CylindricalSurface.hxx>
+#include <Geom_ElementarySurface.hxx>
 #include <Geom_Ellipse.hxx>
 #include <Geom_Line.hxx>
 #include <Geom_OffsetSurface.hxx>
@@ -160,6 +161,20 @@ Vec3 vec(const gp_Vec& p) { return {p.X(), p.Y(), p.Z()}; }
 // read back with two whole circles for one). It fails as a face that crossed itself does: a
 // band first takes a seam of its own (seamed_band()), which splits no loop.
 constexpr const char* kNoLengthLoop = "an edge of its face closes on its vertex with no length";
+// A face that is no band (a sphere's cap round its pole: the fix's seam from the loop to the
+// pole splits the loop where it starts) gets its surface's seam turned about the axis instead,
+// by the golden angle, so that later turns never come back near one tried before; at most
+// kSeamTurns times.
+constexpr double kSeamTurn = 2 * std::numbers::pi * (1 - 1 / std::numbers::phi);
+constexpr int kSeamTurns = 2;
+
+// `g` turned about its own axis by `turns` seam turns (an elementary surface of revolution: the
+// same surface, its seam elsewhere); others as they are.
+Handle(Geom_Surface) seam_turned(const Handle(Geom_Surface) & g, int turns) {
+    const Handle(Geom_ElementarySurface) e = Handle(Geom_ElementarySurface)::DownCast(g);
+    if (turns == 0 || e.IsNull() || e->IsKind(STANDARD_TYPE(Geom_Plane))) return g;
+    return Handle(Geom_Surface)::DownCast(e->Rotated(e->Position().Axis(), turns * kSeamTurn));
+}
 
 // Whether `face` has such an edge.
 bool has_no_length_loop(const TopoDS_Face& face) {
@@ -1393,6 +1408,8 @@ gp_Pnt2d revolution_uv(const GeomAdaptor_Surface& s, const gp_Pnt& p, const gp_P
         ElSLib::Parameters(s.Cylinder(), p, u, v);
     } else if (s.GetType() == GeomAbs_Cone) {
         ElSLib::Parameters(s.Cone(), p, u, v);
+    } else if (s.GetType() == GeomAbs_Sphere) {
+        ElSLib::Parameters(s.Sphere(), p, u, v);
     } else {
         ElSLib::Parameters(s.Torus(), p, u, v);
         v += kTurn * std::round((near.Y() - v) / kTurn);
@@ -1407,7 +1424,6 @@ gp_Pnt2d revolution_uv(const GeomAdaptor_Surface& s, const gp_Pnt& p, const gp_P
 // exactly, and its curve on `s` is a line of (u, v), which the STEP then carries as such.
 std::vector<Handle(Geom_Curve)> isolines_through(const Handle(Geom_Surface) & s,
                                                  const std::vector<gp_Pnt>& points) {
-    constexpr double kTurn = 2 * std::numbers::pi;
     const GeomAdaptor_Surface a(s);
     const GeomAbs_SurfaceType type = a.GetType();
     if (points.empty() || (type != GeomAbs_Cylinder && type != GeomAbs_Cone &&
@@ -1417,14 +1433,7 @@ std::vector<Handle(Geom_Curve)> isolines_through(const Handle(Geom_Surface) & s,
     double su = 0, sv = 0;
     gp_Pnt2d near(0, 0);
     for (const gp_Pnt& p : points) {
-        gp_Pnt2d uv;
-        if (type == GeomAbs_Sphere) {
-            double u = 0, v = 0;
-            ElSLib::Parameters(a.Sphere(), p, u, v);
-            uv.SetCoord(u + kTurn * std::round((near.X() - u) / kTurn), v);
-        } else {
-            uv = revolution_uv(a, p, near);
-        }
+        const gp_Pnt2d uv = revolution_uv(a, p, near);
         near = uv;
         su += uv.X();
         sv += uv.Y();
@@ -1928,7 +1937,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
     // Regions whose face is a band round a cylinder's, cone's or torus's axis, or a cap round
     // a cone's apex or a spindle torus's axis point (seamed_band), and those of them whose face
     // takes its own seam after it failed with the fix's.
-    std::vector<std::uint8_t> is_band_face(nr, 0), own_seam(nr, 0);
+    std::vector<std::uint8_t> is_band_face(nr, 0), own_seam(nr, 0), seam_turns(nr, 0);
     // Corners (mesh vertex ids) solved without it after a face or chain at them failed with it
     // (a corner moved along a coarse mesh's contact band can pass its chain's next point).
     std::unordered_set<std::uint32_t> plain_at;
@@ -1955,7 +1964,8 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             }
             std::string why;
             try {
-                geom[r] = geom_surface(regions[r].surface, bd.shapes[r], why);
+                geom[r] =
+                    seam_turned(geom_surface(regions[r].surface, bd.shapes[r], why), seam_turns[r]);
                 if (!geom[r].IsNull()) sense[r] = natural_sense(geom[r], m, bd.shapes[r]);
             } catch (const Standard_Failure& f) {
                 geom[r].Nullify();
@@ -2997,6 +3007,10 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
                 bool tried = false;
                 if (is_band_face[r] && !own_seam[r]) {
                     own_seam[r] = 1;
+                    tried = true;
+                } else if (why == kNoLengthLoop && seam_turns[r] < kSeamTurns) {
+                    ++seam_turns[r];
+                    geom[r] = seam_turned(geom[r], 1);
                     tried = true;
                 }
                 if (make_plain(r)) tried = true;
