@@ -64,19 +64,23 @@ def main():
         d = [p[k] - center[k] for k in range(3)]
         return [sum(r[i][j] * d[j] for j in range(3)) + center[i] for i in range(3)]
 
+    write_triangles(sys.argv[2], [[turn(p) for p in t] for t in tris])
+
+
+def write_triangles(path, tris):
+    """Writes triangles (three (x, y, z) each) as a binary STL, float32, with their normals."""
     out = bytearray(80) + struct.pack("<I", len(tris))
-    for t in tris:
-        a, b, c = (turn(p) for p in t)
+    for a, b, c in tris:
         u = [b[k] - a[k] for k in range(3)]
         v = [c[k] - a[k] for k in range(3)]
         n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
         length = math.sqrt(sum(x * x for x in n)) or 1.0
         out += struct.pack("<12f", *(x / length for x in n), *a, *b, *c) + b"\0\0"
     # Written beside the output, then renamed: a reader never sees half a file.
-    tmp = sys.argv[2] + ".tmp"
+    tmp = path + ".tmp"
     with open(tmp, "wb") as f:
         f.write(out)
-    os.replace(tmp, sys.argv[2])
+    os.replace(tmp, path)
 
 
 if __name__ == "__main__":
