@@ -705,6 +705,21 @@ TEST(ReverseSurfaces, CornersOfFourSurfacesAreOneVertex) {
     expect_exact(o, "ctc04");
 }
 
+/// The corpus part `file` with every mesh coordinate x replaced by round(x) (rounding another
+/// program could have done: scripts/round_stl.py), reversed: a valid solid, no fallback.
+template <class Round>
+void expect_no_fallback_rounded(const char* file, const std::string& tag, Round round) {
+    const auto path = corpus_step_dir() / file;
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    SamplePart part = corpus_part(path);
+    for (Vec3& p : part.mesh.points)
+        for (int k = 0; k < 3; ++k) p[k] = round(static_cast<float>(p[k]));
+    const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, tag);
+    expect_solid(o, tag);
+    for (const ReverseFallback& f : o.report.fallbacks)
+        ADD_FAILURE() << f.region << " (" << f.kind << "): " << f.reason;
+}
+
 // The same part with every coordinate moved by at most one float32 unit (up, down or not, by its
 // own bits): rounding that any file can carry. Each countersunk hole's two circles then had their
 // vertices at other places round the hole, and the face fix, adding a seam from the one to the
@@ -715,22 +730,12 @@ TEST(ReverseSurfaces, CornersOfFourSurfacesAreOneVertex) {
 // coordinates nudged otherwise). Such a face now fails as it is built, and takes a seam of its
 // own between its loops' vertices: no fallback.
 TEST(ReverseSurfaces, NoEdgeClosesOnItsVertexWithNoLength) {
-    const auto path = corpus_step_dir() / "nist_ctc_04_asme1_rd.stp";
-    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
-    SamplePart part = corpus_part(path);
-    for (Vec3& p : part.mesh.points) {
-        for (int k = 0; k < 3; ++k) {
-            const auto x = static_cast<float>(p[k]);
-            std::uint32_t bits = 0;
-            std::memcpy(&bits, &x, sizeof bits);
-            const int step = static_cast<int>((bits * 2654435761u) >> 30) % 3 - 1;
-            p[k] = step == 0 ? x : std::nextafter(x, step * std::numeric_limits<float>::infinity());
-        }
-    }
-    const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "ctc04_nudged");
-    expect_solid(o, "ctc04_nudged");
-    for (const ReverseFallback& f : o.report.fallbacks)
-        ADD_FAILURE() << f.region << " (" << f.kind << "): " << f.reason;
+    expect_no_fallback_rounded("nist_ctc_04_asme1_rd.stp", "ctc04_nudged", [](float x) {
+        std::uint32_t bits = 0;
+        std::memcpy(&bits, &x, sizeof bits);
+        const int step = static_cast<int>((bits * 2654435761u) >> 30) % 3 - 1;
+        return step == 0 ? x : std::nextafter(x, step * std::numeric_limits<float>::infinity());
+    });
 }
 
 // NIST FTC 07 as an ASCII STL written with six significant digits carries it: every coordinate
@@ -739,20 +744,11 @@ TEST(ReverseSurfaces, NoEdgeClosesOnItsVertexWithNoLength) {
 // its loop to the pole, and the surface is now turned about its axis to put that seam
 // elsewhere: no fallback.
 TEST(ReverseSurfaces, ACapsSeamIsTurnedOffItsLoopsVertex) {
-    const auto path = corpus_step_dir() / "nist_ftc_07_asme1_rd.stp";
-    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
-    SamplePart part = corpus_part(path);
-    for (Vec3& p : part.mesh.points) {
-        for (int k = 0; k < 3; ++k) {
-            char text[32];
-            std::snprintf(text, sizeof text, "%.5e", static_cast<double>(static_cast<float>(p[k])));
-            p[k] = static_cast<float>(std::strtod(text, nullptr));
-        }
-    }
-    const Outcome o = reverse_part(part, false, ReverseMethod::kAuto, "ftc07_six_digits");
-    expect_solid(o, "ftc07_six_digits");
-    for (const ReverseFallback& f : o.report.fallbacks)
-        ADD_FAILURE() << f.region << " (" << f.kind << "): " << f.reason;
+    expect_no_fallback_rounded("nist_ftc_07_asme1_rd.stp", "ftc07_six_digits", [](float x) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.5e", static_cast<double>(x));
+        return static_cast<float>(std::strtod(text, nullptr));
+    });
 }
 
 // The M6 screw's thread (~270 regions of cones, tori and planes along a helix): the face of
