@@ -1048,8 +1048,9 @@ FitResult refine_cone(ConeModel& m, const FitInput& in) {
     // leave it is that plane as far as they tell: nothing a machinist would name a cone, and
     // its apex, which can lie among the points, makes a face on it degenerate (occt_TR12J's
     // mesh with its coordinates nudged by one float32 unit: a 42-facet region 0.26 mm off a cone
-    // of half-angle pi/2 - 8e-8 through the middle of it, whose face, curves half round the apex
-    // on a 1.4 mm edge, failed as its surface, as its mesh edges, and fell back to facets).
+    // of half-angle pi/2 - 8e-8 with its apex in the middle of it: its face, one edge of 1.4 mm
+    // running half round the apex, failed on its surface and on its mesh edges, and fell back
+    // to facets).
     if (res.ok && turning_extent(in) / std::tan(m.alpha) <= res.max) {
         res.ok = false;
         res.failure = "the cone is flat: a plane within its residual";
