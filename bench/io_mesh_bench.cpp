@@ -11,6 +11,9 @@ namespace ncrev::bench {
 namespace {
 
 constexpr std::size_t k100k = 100'000, k1M = 1'000'000, k5M = 5'000'000;
+// The three mesh sizes, in milliseconds of wall time (the reads and builds use every core).
+#define NCREV_MESH_SIZES \
+    ->Arg(k100k)->Arg(k1M)->Arg(k5M)->Unit(benchmark::kMillisecond)->UseRealTime()
 
 std::span<const std::byte> as_bytes(const std::string& s) {
     return {reinterpret_cast<const std::byte*>(s.data()), s.size()};
@@ -30,12 +33,7 @@ void BM_ReadStlBinary(benchmark::State& state) {
     state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * bytes.size()));
     state.counters["facets"] = static_cast<double>(facets);
 }
-BENCHMARK(BM_ReadStlBinary)
-    ->Arg(k100k)
-    ->Arg(k1M)
-    ->Arg(k5M)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_ReadStlBinary) NCREV_MESH_SIZES;
 
 // The same with the exact weld done while reading (what `ncrev info` does).
 void BM_ReadStlBinaryWelding(benchmark::State& state) {
@@ -53,12 +51,7 @@ void BM_ReadStlBinaryWelding(benchmark::State& state) {
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * facets));
     state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * bytes.size()));
 }
-BENCHMARK(BM_ReadStlBinaryWelding)
-    ->Arg(k100k)
-    ->Arg(k1M)
-    ->Arg(k5M)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_ReadStlBinaryWelding) NCREV_MESH_SIZES;
 
 void BM_ReadStlAscii(benchmark::State& state) {
     const auto n = static_cast<std::size_t>(state.range(0));
@@ -176,12 +169,7 @@ void BM_ReadAndBuildFile(benchmark::State& state) {
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * facets));
     state.counters["peak_heap_B_per_facet"] = peak_per_facet;
 }
-BENCHMARK(BM_ReadAndBuildFile)
-    ->Arg(k100k)
-    ->Arg(k1M)
-    ->Arg(k5M)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_ReadAndBuildFile) NCREV_MESH_SIZES;
 
 // The part's size in every pose (part_size(), the segmentation's tolerance), against the
 // bounding box's diagonal it replaced, on the torus: no planar face, so its three largest
@@ -191,12 +179,7 @@ void BM_PartSize(benchmark::State& state) {
     for (auto _ : state) benchmark::DoNotOptimize(part_size(m));
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * m.num_faces()));
 }
-BENCHMARK(BM_PartSize)
-    ->Arg(k100k)
-    ->Arg(k1M)
-    ->Arg(k5M)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_PartSize) NCREV_MESH_SIZES;
 
 void BM_BoxDiagonal(benchmark::State& state) {
     const Mesh& m = torus_mesh(static_cast<std::size_t>(state.range(0)));
@@ -207,12 +190,7 @@ void BM_BoxDiagonal(benchmark::State& state) {
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * m.num_faces()));
 }
-BENCHMARK(BM_BoxDiagonal)
-    ->Arg(k100k)
-    ->Arg(k1M)
-    ->Arg(k5M)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_BoxDiagonal) NCREV_MESH_SIZES;
 
 }  // namespace
 }  // namespace ncrev::bench

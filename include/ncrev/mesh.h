@@ -232,6 +232,11 @@ VertexMap<Vec3> vertex_normals(const Mesh& mesh);
 /// round part's directions all give one box; a part's large planar faces are not parted).
 double part_size(const Mesh& mesh);
 
+/// The rounding unit of the mesh's coordinates: the largest |coordinate| times float32's
+/// epsilon (2^-24) when every coordinate is a float (a binary STL, or text written from floats),
+/// else double's (2^-53). The same whatever the thread count.
+double coordinate_rounding(const Mesh& mesh);
+
 /// The default weld tolerance for points whose bounding box is `box`, and its rule in words.
 double default_weld_tolerance(const Box3& box, std::string* rule = nullptr);
 

@@ -157,8 +157,8 @@ Vec3 vec(const gp_Vec& p) { return {p.X(), p.Y(), p.Z()}; }
 // two ends: one whose ends are the same vertex on a closed curve is read as the whole curve. The
 // face fix puts such a piece on a band's loop where it splits the loop at the seam it adds and the
 // loop's own vertex is already there (NIST CTC 04's countersunk holes, their mesh's vertices
-// moved by one float32 unit: each loop's vertex elsewhere round the hole, and two to four faces
-// read back with two whole circles for one). It fails as a face that crossed itself does: a
+// moved by one float32 unit: each loop's vertex elsewhere round the hole, and two faces read
+// back with two whole circles for one). It fails as a face that crossed itself does: a
 // band first takes a seam of its own (seamed_band()), which splits no loop.
 constexpr const char* kNoLengthLoop = "an edge of its face closes on its vertex with no length";
 // A face that is no band (a sphere's cap round its pole: the fix's seam from the loop to the

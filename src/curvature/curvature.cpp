@@ -667,34 +667,8 @@ CurvatureResult compute_curvature(const Mesh& m, const CurvatureOptions& options
             data[v] = vertex_pass(m, fd, VertexId(static_cast<std::uint32_t>(v)));
     });
 
-    // Largest |coordinate|, and whether every coordinate is a float32 (max and "and" are
-    // exact, so the parallel reduction is deterministic).
-    struct Extent {
-        double max_abs = 0;
-        bool all_float = true;
-    };
-    const auto positions = m.positions();
-    const Extent ext = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, positions.size()), Extent{},
-        [&](const auto& r, Extent e) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const Vec3 p = positions[i];
-                for (int k = 0; k < 3; ++k) {
-                    e.max_abs = std::max(e.max_abs, std::fabs(p[k]));
-                    e.all_float &= static_cast<double>(static_cast<float>(p[k])) == p[k];
-                }
-            }
-            return e;
-        },
-        [](Extent a, const Extent& b) {
-            a.max_abs = std::max(a.max_abs, b.max_abs);
-            a.all_float = a.all_float && b.all_float;
-            return a;
-        });
     const double size = part_size(m);
-    // The rounding unit of the coordinates: float32's when every coordinate is a float (binary
-    // STL, or text written from floats), else double's.
-    th.coordinate_precision = ext.max_abs * (ext.all_float ? 0x1.0p-24 : 0x1.0p-53);
+    th.coordinate_precision = coordinate_rounding(m);
     th.median_edge_length = median_edge_length(m);
     if (options.planar_curvedness >= 0) {
         th.planar_curvedness = options.planar_curvedness;

@@ -1051,7 +1051,11 @@ FitResult refine_cone(ConeModel& m, const FitInput& in) {
     // of half-angle pi/2 - 8e-8 with its apex in the middle of it: its face, one edge of 1.4 mm
     // running half round the apex, failed on its surface and on its mesh edges, and fell back
     // to facets).
-    if (res.ok && turning_extent(in) / std::tan(m.alpha) <= res.max) {
+    // Any two points' distance bounds the extent from below: most cones are decided by the
+    // first and last without a pass over the points.
+    const double flat_reach = res.max * std::tan(m.alpha);
+    if (res.ok && !in.points.empty() && norm(in.points.back() - in.points.front()) <= flat_reach &&
+        turning_extent(in) <= flat_reach) {
         res.ok = false;
         res.failure = "the cone is flat: a plane within its residual";
     }

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -307,6 +308,34 @@ double part_size(const Mesh& m) {
     double best = std::numeric_limits<double>::infinity();
     for (const Direction& d : dirs) best = std::min(best, box_diagonal2_along(m.positions(), d.n));
     return std::sqrt(best);
+}
+
+double coordinate_rounding(const Mesh& m) {
+    // max and "and" are exact: the parallel reduction is deterministic.
+    struct Extent {
+        double max_abs = 0;
+        bool all_float = true;
+    };
+    const std::span<const Vec3> points = m.positions();
+    const Extent e = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, points.size(), kPointGrain), Extent{},
+        [&](const tbb::blocked_range<std::size_t>& range, Extent acc) {
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                for (int k = 0; k < 3; ++k) {
+                    const double x = points[i][k];
+                    acc.max_abs = std::max(acc.max_abs, std::fabs(x));
+                    acc.all_float =
+                        acc.all_float && static_cast<double>(static_cast<float>(x)) == x;
+                }
+            }
+            return acc;
+        },
+        [](Extent a, const Extent& b) {
+            a.max_abs = std::max(a.max_abs, b.max_abs);
+            a.all_float = a.all_float && b.all_float;
+            return a;
+        });
+    return e.max_abs * (e.all_float ? 0x1.0p-24 : 0x1.0p-53);
 }
 
 double dihedral_angle(const Mesh& m, HalfedgeId h) {

@@ -3045,20 +3045,6 @@ std::vector<std::uint32_t> merge_helical(Context& c, std::vector<Draft>& drafts)
     return grown;
 }
 
-/// The rounding unit of the mesh's coordinates: the largest |coordinate| times float's epsilon
-/// when every coordinate is a float (an STL), else double's.
-double coordinate_rounding(const Mesh& m) {
-    double max_abs = 0;
-    bool all_float = true;
-    for (const Vec3& p : m.positions()) {
-        for (const double x : {p.x, p.y, p.z}) {
-            max_abs = std::max(max_abs, std::abs(x));
-            all_float = all_float && static_cast<double>(static_cast<float>(x)) == x;
-        }
-    }
-    return max_abs * (all_float ? 0x1.0p-24 : 0x1.0p-53);
-}
-
 /// Snapping (SnapOptions::rms_floor) allows a rise of the RMS residual of this many rounding
 /// units of the coordinates (coordinate_rounding()) whatever the noise: a change the rounding of
 /// the vertices could hide. A binary STL rounds them to floats, not at random across a face:
