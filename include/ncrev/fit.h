@@ -154,6 +154,13 @@ struct FitInput {
     /// sample tries nets at least as fine as the whole would, one of which holds it with that
     /// RMS at least.
     double refuse_rms = 0;
+    /// Points a B-spline net over the mean plane (fit_bspline()) is drawn towards without
+    /// being held to them: a mesh's facet and edge middles, which lie within its chordal
+    /// deflection of the surface (inside it), where its vertices do not hold the net (a long
+    /// border edge, whose two ends alone let the net swing between them). Each weighs
+    /// kGuideWeight x the points' mean weight: enough to hold the net where no point does,
+    /// too little to pull it off the points. Not in the residuals; no other kind uses them.
+    std::span<const Vec3> guides{};
 };
 
 /// The fewest points a fit samples first (FitInput::refuse_rms): eight times the sample, so

@@ -69,6 +69,13 @@ constexpr int kReadBackRetries = 3;
 /// A refitted B-spline keeps the middles of its region's facets and border edges within this
 /// many chordal deflections, as segmentation holds a B-spline's chords (chords_agree()).
 constexpr double kChordMiddles = 2;
+/// A region's B-spline from segmentation whose middles of facets and border edges lie farther
+/// than this many chordal deflections from it swings between its vertices: an edge's middle
+/// sags up to one deflection off the surface, a facet's 4/3 as much (segment.cpp,
+/// kMiddleSagFactor). TR12J: a 156-facet net 1.8 deflections off a border edge's middle whose
+/// ends it holds within 0.02 mm, and 2.1 at three eighths of it; its two plane neighbours,
+/// tangent to it there, found no edge curve within the deflection.
+constexpr double kGuidedMiddles = 4.0 / 3;
 
 }  // namespace
 
@@ -297,7 +304,8 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     // of a border edge whose ends it passes within 0.01 mm, and no edge curve with its
     // neighbour could follow it): it is kept only while the middles of the region's facets and
     // of its border's edges stay within twice the deflection, as segmenting held them
-    // (kChordMiddles).
+    // (kChordMiddles). Segmentation's own net may swing so too, where no refit holds: then it
+    // is fitted again with the middles as guides (kGuidedMiddles).
     std::vector<FitResult> refits(sr.regions.size());
     stage("refit", [&] {
         std::vector<std::vector<Vec3>> points(sr.regions.size()), middles(sr.regions.size());
@@ -334,20 +342,35 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         const double middle_limit = kChordMiddles * sr.chordal_deflection;
         for (std::size_t r = 0; r < sr.regions.size(); ++r) {
             if (points[r].empty()) continue;
+            const auto worst_middle = [&](const Surface& s) {
+                double w = 0;
+                for (const Vec3& p : middles[r]) w = std::max(w, distance(s, p));
+                return w;
+            };
             FitInput in;
             in.points = points[r];
             // The tightest of tolerance x 1, 4, 16 ... that a net reaches with the facets its
             // chords.
-            for (double tol = sr.tolerance; tol < sr.regions[r].fit.max; tol *= 4) {
+            const double held = sr.regions[r].fit.max;
+            for (double tol = sr.tolerance; tol < held; tol *= 4) {
                 FitResult f = fit_bspline(in, tol);
-                if (!f.ok || !(f.max < sr.regions[r].fit.max)) continue;
-                const bool chords = std::none_of(
-                    middles[r].begin(), middles[r].end(),
-                    [&](const Vec3& p) { return distance(f.surface, p) > middle_limit; });
-                if (chords) {
+                if (!f.ok || !(f.max < held)) continue;
+                if (worst_middle(f.surface) <= middle_limit) {
                     refits[r] = std::move(f);
                     break;
                 }
+            }
+            // None, and segmentation's own net swings past a middle by more than a chord
+            // sags (kGuidedMiddles): fitted again to the vertices within the deflection, as
+            // segmentation held them, drawn towards the middles (FitInput::guides); taken
+            // where its middles are nearer.
+            if (refits[r].ok) continue;
+            const double swing = worst_middle(sr.regions[r].fit.surface);
+            if (!(swing > kGuidedMiddles * sr.chordal_deflection)) continue;
+            in.guides = middles[r];
+            FitResult f = fit_bspline(in, sr.chordal_deflection);
+            if (f.ok && f.max <= sr.chordal_deflection && worst_middle(f.surface) < swing) {
+                refits[r] = std::move(f);
             }
         }
     });

@@ -189,6 +189,10 @@ constexpr int kBSplineMaxPoles = 64;
 /// extrusion's poles against its pieces' parameters).
 constexpr double kNetGrowth = 1.5;
 constexpr double kBSplineSmoothing = 1e-6;
+/// The weight of a guide (FitInput::guides) against a point's: a guide lies up to the mesh's
+/// deflection inside the surface, and pulls the net a tenth of that off the points where both
+/// hold it; where no point holds it, the guides alone do.
+constexpr double kGuideWeight = 0.1;
 constexpr double kBSplineDefaultTolerance = 1e-4;
 constexpr int kProjectIterations = 20;
 /// Samples per profile pole of an extrusion's start grid (coarse_start()).
@@ -1473,6 +1477,27 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
                     const int row = (su + a) + nu * (sv + b);
                     const double fa = w * Nu[a] * Nv[b];
                     rhs[static_cast<std::size_t>(row)] += fa * z[i];
+                    for (int bb = 0; bb <= 3; ++bb)
+                        for (int aa = 0; aa <= 3; ++aa)
+                            entry(row, aa - a, bb - b) += fa * Nu[aa] * Nv[bb];
+                }
+            }
+        }
+        // The guides (FitInput::guides), at their places over the mean plane (within the
+        // points' extent: a guide is a middle of facets whose corners are points).
+        for (const Vec3& g : in.guides) {
+            const Vec3 q = g - c;
+            const double gu = std::clamp((dot(q, e1) - x0) / (x1 - x0), 0.0, 1.0),
+                         gv = std::clamp((dot(q, e2) - y0) / (y1 - y0), 0.0, 1.0);
+            double Nu[kMaxDegree + 1], Nv[kMaxDegree + 1];
+            const int su = cubic_basis(nu, gu, Nu, nullptr) - 3,
+                      sv = cubic_basis(nv, gv, Nv, nullptr) - 3;
+            const double w = kGuideWeight * total / static_cast<double>(n);
+            for (int b = 0; b <= 3; ++b) {
+                for (int a = 0; a <= 3; ++a) {
+                    const int row = (su + a) + nu * (sv + b);
+                    const double fa = w * Nu[a] * Nv[b];
+                    rhs[static_cast<std::size_t>(row)] += fa * dot(q, nrm);
                     for (int bb = 0; bb <= 3; ++bb)
                         for (int aa = 0; aa <= 3; ++aa)
                             entry(row, aa - a, bb - b) += fa * Nu[aa] * Nv[bb];
