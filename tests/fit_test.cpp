@@ -619,6 +619,42 @@ TEST(FitBSpline, FreeFormPatchWithinToleranceAndChosenLast) {
     }
 }
 
+// A height field over 40 x 30 (a die's bumps), its points at random where `keep` says.
+template <class Keep>
+void bumps(test::Rng& rng, int n, Keep&& keep, std::vector<Vec3>& points) {
+    while (static_cast<int>(points.size()) < n) {
+        const double x = 40 * rng.uniform(), y = 30 * rng.uniform();
+        if (keep(x)) points.push_back({x, y, 3 * std::sin(x / 8) * std::cos(y / 11)});
+    }
+}
+double bump_height(double x, double y) { return 3 * std::sin(x / 8) * std::cos(y / 11); }
+
+// FitInput::margin: the net reaches past its points by that part of their extent, so a point
+// of the surface just beyond them (a border curve bowing out between two border vertices) is
+// on it; without, the nearest point is on the net's edge.
+TEST(FitBSpline, AMarginCarriesTheNetPastItsPoints) {
+    test::Rng rng(41);
+    std::vector<Vec3> points;
+    bumps(
+        rng, 3000, [](double) { return true; }, points);
+    const double tol = 1e-3 * 40;
+    FitInput in{points, {}, {}};
+    const FitResult plain = fit_bspline(in, tol);
+    in.margin = 0.05;
+    const FitResult wide = fit_bspline(in, tol);
+    ASSERT_TRUE(plain.ok && wide.ok) << plain.failure << wide.failure;
+    EXPECT_LE(wide.max, tol);
+    double plain_far = 0, wide_far = 0;
+    for (double y = 2; y < 28; y += 2) {
+        // 1 beyond the points' largest x (40): 2.5 % of the extent.
+        const Vec3 q{41, y, bump_height(41, y)};
+        plain_far = std::max(plain_far, distance(plain.surface, q));
+        wide_far = std::max(wide_far, distance(wide.surface, q));
+    }
+    EXPECT_GT(plain_far, 10 * tol);
+    EXPECT_LE(wide_far, 2 * tol);
+}
+
 // A caller that takes no net of more than max_net_poles poles: the fit tries none larger, and
 // fails where the net it needs is larger (the die's bumps at a tenth of the tolerance above).
 TEST(FitBSpline, NoNetLargerThanTheCallerTakes) {

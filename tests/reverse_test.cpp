@@ -1229,11 +1229,13 @@ TEST(ReverseSurfaces, TangentJunctionsOfFittedPiecesHaveEdges) {
     // 6 until the nets that swung between their vertices were fitted again with the middles
     // of their facets and border edges as guides (FitInput::guides): tangent junctions with
     // them then have edge curves, and the farthest point of the solid from the mesh went 1.9
-    // -> 1.2 deflections.
-    EXPECT_LE(o.report.fallbacks.size(), 4u);
+    // -> 1.2 deflections. Then 4 -> 2: the refitted nets reach 5 % past their vertices
+    // (FitInput::margin), and the plane faces' edges along them, which bow out past the
+    // outermost vertices, stay on them.
+    EXPECT_LE(o.report.fallbacks.size(), 2u);
     expect_near_the_part(o, "linkrods");
     ASSERT_TRUE(o.report.deviation.has_value());
-    EXPECT_LE(o.report.deviation->solid_to_mesh.max, 1.5 * o.deflection);
+    EXPECT_LE(o.report.deviation->solid_to_mesh.max, 1.1 * o.deflection);
 }
 
 // Two surfaces tangent along a whole circle (a cone and the torus that rounds its end, on NIST

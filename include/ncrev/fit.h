@@ -161,6 +161,10 @@ struct FitInput {
     /// kGuideWeight x the points' mean weight: enough to hold the net where no point does,
     /// too little to pull it off the points. Not in the residuals; no other kind uses them.
     std::span<const Vec3> guides{};
+    /// When positive, a net over the mean plane (fit_bspline()) spans this fraction of the
+    /// points' extent beyond them on each side (its smoothing term carries it on there), so
+    /// that a curve along the points' border that bows out past them stays on the surface.
+    double margin = 0;
 };
 
 /// The fewest points a fit samples first (FitInput::refuse_rms): eight times the sample, so

@@ -76,6 +76,12 @@ constexpr double kChordMiddles = 2;
 /// ends it holds within 0.02 mm, and 2.1 at three eighths of it; its two plane neighbours,
 /// tangent to it there, found no edge curve within the deflection.
 constexpr double kGuidedMiddles = 4.0 / 3;
+/// A refitted net spans this fraction of its vertices' extent beyond them on each side
+/// (FitInput::margin): a border curve bows out past the outermost vertices between them, and
+/// on a net that ends at those vertices the edge curve along it leaves the surface (the link
+/// rods' plane faces tangent to their B-splines: 4 -> 2 fallbacks; 2 % gave 3). Wider nets spread
+/// their poles thinner: freeform_die's coarse net ends farther from the mesh (1.40 -> 1.60 δ).
+constexpr double kNetMargin = 0.05;
 
 }  // namespace
 
@@ -349,6 +355,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             };
             FitInput in;
             in.points = points[r];
+            in.margin = kNetMargin;
             // The tightest of tolerance x 1, 4, 16 ... that a net reaches with the facets its
             // chords.
             const double held = sr.regions[r].fit.max;

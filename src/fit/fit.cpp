@@ -1424,6 +1424,11 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
         fail.failure = "the points span no area";
         return fail;
     }
+    // The net's domain: the points' extent, and FitInput::margin of it beyond on each side.
+    if (in.margin > 0) {
+        const double ex = in.margin * (x1 - x0), ey = in.margin * (y1 - y0);
+        x0 -= ex, x1 += ex, y0 -= ey, y1 += ey;
+    }
     std::vector<double> u(n), v(n);
     for (std::size_t i = 0; i < n; ++i)
         u[i] = (x[i] - x0) / (x1 - x0), v[i] = (y[i] - y0) / (y1 - y0);
