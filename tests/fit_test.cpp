@@ -619,24 +619,23 @@ TEST(FitBSpline, FreeFormPatchWithinToleranceAndChosenLast) {
     }
 }
 
-// A height field over 40 x 30 (a die's bumps), its points at random where `keep` says.
-template <class Keep>
-void bumps(test::Rng& rng, int n, Keep&& keep, std::vector<Vec3>& points) {
-    while (static_cast<int>(points.size()) < n) {
-        const double x = 40 * rng.uniform(), y = 30 * rng.uniform();
-        if (keep(x)) points.push_back({x, y, 3 * std::sin(x / 8) * std::cos(y / 11)});
-    }
-}
+// A height field over 40 x 30 (a die's bumps), and n of its points at random.
 double bump_height(double x, double y) { return 3 * std::sin(x / 8) * std::cos(y / 11); }
+std::vector<Vec3> bumps(test::Rng& rng, int n) {
+    std::vector<Vec3> points;
+    for (int i = 0; i < n; ++i) {
+        const double x = 40 * rng.uniform(), y = 30 * rng.uniform();
+        points.push_back({x, y, bump_height(x, y)});
+    }
+    return points;
+}
 
 // FitInput::margin: the net reaches past its points by that part of their extent, so a point
 // of the surface just beyond them (a border curve bowing out between two border vertices) is
 // on it; without, the nearest point is on the net's edge.
 TEST(FitBSpline, AMarginCarriesTheNetPastItsPoints) {
     test::Rng rng(41);
-    std::vector<Vec3> points;
-    bumps(
-        rng, 3000, [](double) { return true; }, points);
+    const std::vector<Vec3> points = bumps(rng, 3000);
     const double tol = 1e-3 * 40;
     FitInput in{points, {}, {}};
     const FitResult plain = fit_bspline(in, tol);
