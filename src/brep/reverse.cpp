@@ -10,6 +10,7 @@
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <numeric>
 #include <optional>
 
@@ -348,11 +349,16 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
         const double middle_limit = kChordMiddles * sr.chordal_deflection;
         for (std::size_t r = 0; r < sr.regions.size(); ++r) {
             if (points[r].empty()) continue;
-            const auto worst_middle = [&](const Surface& s) {
+            // The farthest middle from `s`, or the first farther than `stop`.
+            const auto worst_middle = [&](const Surface& s, double stop) {
                 double w = 0;
-                for (const Vec3& p : middles[r]) w = std::max(w, distance(s, p));
+                for (const Vec3& p : middles[r]) {
+                    w = std::max(w, distance(s, p));
+                    if (w > stop) break;
+                }
                 return w;
             };
+            constexpr double kAll = std::numeric_limits<double>::infinity();
             FitInput in;
             in.points = points[r];
             in.margin = kNetMargin;
@@ -362,7 +368,7 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             for (double tol = sr.tolerance; tol < held; tol *= 4) {
                 FitResult f = fit_bspline(in, tol);
                 if (!f.ok || !(f.max < held)) continue;
-                if (worst_middle(f.surface) <= middle_limit) {
+                if (worst_middle(f.surface, middle_limit) <= middle_limit) {
                     refits[r] = std::move(f);
                     break;
                 }
@@ -372,11 +378,11 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             // segmentation held them, drawn towards the middles (FitInput::guides); taken
             // where its middles are nearer.
             if (refits[r].ok) continue;
-            const double swing = worst_middle(sr.regions[r].fit.surface);
+            const double swing = worst_middle(sr.regions[r].fit.surface, kAll);
             if (!(swing > kGuidedMiddles * sr.chordal_deflection)) continue;
             in.guides = middles[r];
             FitResult f = fit_bspline(in, sr.chordal_deflection);
-            if (f.ok && f.max <= sr.chordal_deflection && worst_middle(f.surface) < swing) {
+            if (f.ok && f.max <= sr.chordal_deflection && worst_middle(f.surface, swing) < swing) {
                 refits[r] = std::move(f);
             }
         }

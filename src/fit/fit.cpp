@@ -1432,6 +1432,17 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
     std::vector<double> u(n), v(n);
     for (std::size_t i = 0; i < n; ++i)
         u[i] = (x[i] - x0) / (x1 - x0), v[i] = (y[i] - y0) / (y1 - y0);
+    // The guides (FitInput::guides) at their places over the mean plane (within the points'
+    // extent: a guide is a middle of facets whose corners are points), and their weight.
+    const std::size_t ng = in.guides.size();
+    std::vector<double> guide_u(ng), guide_v(ng), guide_z(ng);
+    for (std::size_t i = 0; i < ng; ++i) {
+        const Vec3 q = in.guides[i] - c;
+        guide_u[i] = std::clamp((dot(q, e1) - x0) / (x1 - x0), 0.0, 1.0);
+        guide_v[i] = std::clamp((dot(q, e2) - y0) / (y1 - y0), 0.0, 1.0);
+        guide_z[i] = dot(q, nrm);
+    }
+    const double guide_weight = kGuideWeight * total / static_cast<double>(n);
     // Net sizes: 4 along the shorter side to start (then kNetGrowth x as many), proportional to
     // the extents.
     const double aspect = (x1 - x0) / (y1 - y0);
@@ -1472,43 +1483,25 @@ FitResult fit_bspline_impl(const FitInput& in, double tolerance) {
                             kW +
                         static_cast<std::size_t>(db + kMaxDegree)];
         };
-        for (std::size_t i = 0; i < n; ++i) {
+        // A sample of height h at (uu, vv) over the mean plane, weighing w.
+        const auto add_sample = [&](double uu, double vv, double w, double h) {
             double Nu[kMaxDegree + 1], Nv[kMaxDegree + 1];
-            const int su = cubic_basis(nu, u[i], Nu, nullptr) - 3,
-                      sv = cubic_basis(nv, v[i], Nv, nullptr) - 3;
-            const double w = weight(in, i);
+            const int su = cubic_basis(nu, uu, Nu, nullptr) - 3,
+                      sv = cubic_basis(nv, vv, Nv, nullptr) - 3;
             for (int b = 0; b <= 3; ++b) {
                 for (int a = 0; a <= 3; ++a) {
                     const int row = (su + a) + nu * (sv + b);
                     const double fa = w * Nu[a] * Nv[b];
-                    rhs[static_cast<std::size_t>(row)] += fa * z[i];
+                    rhs[static_cast<std::size_t>(row)] += fa * h;
                     for (int bb = 0; bb <= 3; ++bb)
                         for (int aa = 0; aa <= 3; ++aa)
                             entry(row, aa - a, bb - b) += fa * Nu[aa] * Nv[bb];
                 }
             }
-        }
-        // The guides (FitInput::guides), at their places over the mean plane (within the
-        // points' extent: a guide is a middle of facets whose corners are points).
-        for (const Vec3& g : in.guides) {
-            const Vec3 q = g - c;
-            const double gu = std::clamp((dot(q, e1) - x0) / (x1 - x0), 0.0, 1.0),
-                         gv = std::clamp((dot(q, e2) - y0) / (y1 - y0), 0.0, 1.0);
-            double Nu[kMaxDegree + 1], Nv[kMaxDegree + 1];
-            const int su = cubic_basis(nu, gu, Nu, nullptr) - 3,
-                      sv = cubic_basis(nv, gv, Nv, nullptr) - 3;
-            const double w = kGuideWeight * total / static_cast<double>(n);
-            for (int b = 0; b <= 3; ++b) {
-                for (int a = 0; a <= 3; ++a) {
-                    const int row = (su + a) + nu * (sv + b);
-                    const double fa = w * Nu[a] * Nv[b];
-                    rhs[static_cast<std::size_t>(row)] += fa * dot(q, nrm);
-                    for (int bb = 0; bb <= 3; ++bb)
-                        for (int aa = 0; aa <= 3; ++aa)
-                            entry(row, aa - a, bb - b) += fa * Nu[aa] * Nv[bb];
-                }
-            }
-        }
+        };
+        for (std::size_t i = 0; i < n; ++i) add_sample(u[i], v[i], weight(in, i), z[i]);
+        for (std::size_t i = 0; i < in.guides.size(); ++i)
+            add_sample(guide_u[i], guide_v[i], guide_weight, guide_z[i]);
         // Smoothing: the squared second differences of the heights along both directions,
         // weighted so that it is felt only where there are no points.
         const double lambda = kBSplineSmoothing * total / m;
