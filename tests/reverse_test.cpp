@@ -1015,6 +1015,34 @@ FaceMatch match_faces(const SamplePart& part, bool list = false) {
     return fm;
 }
 
+// NIST FTC 06 written as a binary STL (float32), as a simulator writes it: on its floor a slot's
+// arc (radius 22.225) runs on into a fillet (3.175), tangent by design. Fitted each on its own
+// from the rounded vertices, the two cylinders overlapped by 1.3e-7 mm, so the floor's circles
+// crossed 8.5e-4 mm either side of their corner, far past its tolerance: the floor's wire
+// crossed itself and its 332 facets fell back. The smaller of two such cylinders is now moved a
+// hair apart from the larger (brep_detail::exact_tangencies()).
+TEST(ReverseSurfaces, AFilletMeetsTheArcItRunsOnFromAtTheirCornerFromAFloatMesh) {
+    const auto path = corpus_step_dir() / "nist_ftc_06_asme1_rd.stp";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus at " << path;
+    const SamplePart part = corpus_part(path);
+    const std::vector<std::byte> stl = encode_stl_binary(part.mesh.points, part.mesh.triangles);
+    const Result<TriangleSoup> read = read_stl(stl, "ftc06.stl");
+    ASSERT_TRUE(read.ok()) << read.error().describe();
+    const Result<BuildResult> built = build_mesh(read.value());
+    ASSERT_TRUE(built.ok());
+    const auto out = out_dir() / "ftc06_float.step";
+    const Result<ReverseReport> rev = reverse_to_step(built.value().mesh, out);
+    std::filesystem::remove(out);
+    ASSERT_TRUE(rev.ok()) << rev.error().describe();
+    const ReverseReport& r = rev.value();
+    EXPECT_TRUE(r.solid && r.valid && r.written);
+    EXPECT_GE(r.exact_tangencies, 1u);
+    for (const ReverseFallback& f : r.fallbacks)
+        ADD_FAILURE() << "region " << f.region << " (" << f.kind << ", " << f.facets
+                      << " facets): " << f.reason;
+    EXPECT_EQ(r.faces, 144u);  // the original's
+}
+
 // The M6 screw's flanks (true faces of 1000-1100 facets over seven turns) each ended in a
 // B-spline patch of 93-97 facets that also held a tenth of the thread's faded end: no one
 // helical sweep fits that patch, and 8 % of each flank stayed out of its region. The flank's

@@ -117,6 +117,9 @@ struct ReverseReport {
     /// fitted, polyline; and analytic: of the intersection and tangency edges, those whose
     /// curve is exact (a line, circle or ellipse, a B-spline extrusion's profile).
     std::map<std::string, std::uint64_t> edges_by_curve;
+    /// Regions whose cylinder was moved a hair apart from a larger one it overlapped by a
+    /// fitting error where the two are tangent (a fillet and an arc; docs/brep.md, 1).
+    std::uint64_t exact_tangencies = 0;
     std::uint64_t corners = 0;
     /// Of those, the corners put on the contact curve of two tangent surfaces (a fillet and
     /// its neighbour), where the other surfaces cross it.

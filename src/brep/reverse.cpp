@@ -402,6 +402,9 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                 std::to_string(g.fit.max) + " (tolerance " + std::to_string(sr.tolerance) + ")";
         }
     }
+    // Fillets fitted on their own overlap the arcs they run into by a rounding error; made a
+    // hair apart, a floor cutting both has edges that do not cross beside their corner.
+    rep.exact_tangencies = brep_detail::exact_tangencies(mesh, sr.region, surfaces, sr.tolerance);
     // One face per connected piece: a region in several pieces (segmentation joins every
     // facet that one surface fits, and border refinement can detach a few) becomes one region
     // per piece, each with the region's surface; `origin` maps them back.

@@ -6,6 +6,7 @@ list(APPEND NCREV_OCCT_SOURCES
     ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/step.cpp
     ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/step_direct.cpp
     ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/surfaces.cpp
+    ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/tangency.cpp
     ${CMAKE_CURRENT_SOURCE_DIR}/src/brep/deviation.cpp
 )
 list(APPEND NCREV_OCCT_LIBS

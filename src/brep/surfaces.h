@@ -101,6 +101,17 @@ SurfaceBrep build_surface_brep(const Mesh& mesh, const FaceMap<std::int32_t>& re
                                std::span<const RegionSurface> regions,
                                const SurfaceBrepOptions& options);
 
+/// Tangent cylinders made exact (docs/brep.md, 1): of two adjacent regions that are cylinders
+/// with parallel axes and overlap within what their fits leave open (their vertices' distances
+/// from them plus four coordinate rounding units, at most `tolerance`), the smaller is moved
+/// across its axis (its radius too only where no such move holds all its contacts) so that the
+/// two are a hair apart (1e-9: a hundredth of OpenCASCADE's smallest tolerance): a third face
+/// cutting both then has edges that do not cross beside their corner. Larger ones first; a
+/// move is kept only while the region's vertices stay within `tolerance` of its surface (or as
+/// near as before). Returns the regions moved.
+std::size_t exact_tangencies(const Mesh& mesh, const FaceMap<std::int32_t>& region,
+                             std::vector<RegionSurface>& regions, double tolerance);
+
 /// How far a solid's volume may be from its mesh's, in units of the volume the mesh's own
 /// error spans: the area of its facets on curved surfaces times its chordal deflection (their
 /// vertices lie on the part's surface and the facets within the deflection of it), plus its

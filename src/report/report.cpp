@@ -202,6 +202,7 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
         r["fallback_faces"] = rev.fallback_faces;
         r["absorbed_regions"] = rev.absorbed_regions;
         r["edges_by_curve"] = rev.edges_by_curve;
+        r["exact_tangencies"] = rev.exact_tangencies;
         r["corners"] = rev.corners;
         r["tangent_corners"] = rev.tangent_corners;
         r["max_corner_residual"] = rev.max_corner_residual;
