@@ -1020,27 +1020,47 @@ FaceMatch match_faces(const SamplePart& part, bool list = false) {
 // from the rounded vertices, the two cylinders overlapped by 1.3e-7 mm, so the floor's circles
 // crossed 8.5e-4 mm either side of their corner, far past its tolerance: the floor's wire
 // crossed itself and its 332 facets fell back. The smaller of two such cylinders is now moved a
-// hair apart from the larger (brep_detail::exact_tangencies()).
-TEST(ReverseSurfaces, AFilletMeetsTheArcItRunsOnFromAtTheirCornerFromAFloatMesh) {
+// hair apart from the larger (brep_detail::exact_tangencies()). Written as text with six
+// significant digits, the arcs' axes came 1e-6 off the fillets' too, the gap changing along
+// them: the fillet is turned onto the arc's axis first.
+TEST(ReverseSurfaces, AFilletMeetsTheArcItRunsOnFromAtTheirCornerFromARoundedMesh) {
     const auto path = corpus_step_dir() / "nist_ftc_06_asme1_rd.stp";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus at " << path;
     const SamplePart part = corpus_part(path);
-    const std::vector<std::byte> stl = encode_stl_binary(part.mesh.points, part.mesh.triangles);
-    const Result<TriangleSoup> read = read_stl(stl, "ftc06.stl");
-    ASSERT_TRUE(read.ok()) << read.error().describe();
-    const Result<BuildResult> built = build_mesh(read.value());
-    ASSERT_TRUE(built.ok());
-    const auto out = out_dir() / "ftc06_float.step";
-    const Result<ReverseReport> rev = reverse_to_step(built.value().mesh, out);
-    std::filesystem::remove(out);
-    ASSERT_TRUE(rev.ok()) << rev.error().describe();
-    const ReverseReport& r = rev.value();
-    EXPECT_TRUE(r.solid && r.valid && r.written);
-    EXPECT_GE(r.exact_tangencies, 1u);
-    for (const ReverseFallback& f : r.fallbacks)
-        ADD_FAILURE() << "region " << f.region << " (" << f.kind << ", " << f.facets
-                      << " facets): " << f.reason;
-    EXPECT_EQ(r.faces, 144u);  // the original's
+    std::string text = "solid ftc06\n";
+    char line[160];
+    for (const auto& t : part.mesh.triangles) {
+        text += "facet normal 0 0 0\nouter loop\n";
+        for (const std::uint32_t i : t) {
+            const Vec3 p = part.mesh.points[i];
+            std::snprintf(line, sizeof line, "vertex %.5e %.5e %.5e\n", p.x, p.y, p.z);
+            text += line;
+        }
+        text += "endloop\nendfacet\n";
+    }
+    text += "endsolid ftc06\n";
+    const std::vector<std::byte> binary = encode_stl_binary(part.mesh.points, part.mesh.triangles);
+    for (const bool six_digits : {false, true}) {
+        SCOPED_TRACE(six_digits ? "six digits" : "float32");
+        const std::span<const std::byte> bytes =
+            six_digits ? std::as_bytes(std::span<const char>(text.data(), text.size()))
+                       : std::span<const std::byte>(binary);
+        const Result<TriangleSoup> read = read_stl(bytes, "ftc06.stl");
+        ASSERT_TRUE(read.ok()) << read.error().describe();
+        const Result<BuildResult> built = build_mesh(read.value());
+        ASSERT_TRUE(built.ok());
+        const auto out = out_dir() / "ftc06_rounded.step";
+        const Result<ReverseReport> rev = reverse_to_step(built.value().mesh, out);
+        std::filesystem::remove(out);
+        ASSERT_TRUE(rev.ok()) << rev.error().describe();
+        const ReverseReport& r = rev.value();
+        EXPECT_TRUE(r.solid && r.valid && r.written);
+        EXPECT_GE(r.exact_tangencies, 1u);
+        for (const ReverseFallback& f : r.fallbacks)
+            ADD_FAILURE() << "region " << f.region << " (" << f.kind << ", " << f.facets
+                          << " facets): " << f.reason;
+        EXPECT_EQ(r.faces, 144u);  // the original's
+    }
 }
 
 // The M6 screw's flanks (true faces of 1000-1100 facets over seven turns) each ended in a

@@ -29,9 +29,10 @@ namespace {
 // curves they leave on a third face stay apart after the solve rounds.
 const double kHair = Precision::Confusion() / 100;
 // Axes this close to parallel (sine of their angle) are made parallel with the contact: two
-// fits of one direction from a float32 mesh differ by about 1e-7 (snapping makes them equal);
-// the move is checked against the tolerance below.
-constexpr double kParallel = 1e-6;
+// fits of one direction differ by about 1e-7 from a float32 mesh (snapping makes them equal)
+// and by 1e-6 from six-digit coordinates (NIST FTC 06's slot arcs, 2.5 mm high); the move,
+// a turn about the axis point, is checked against the tolerance below.
+constexpr double kParallel = 1e-4;
 // Coordinate rounding units (coordinate_rounding()) two exact fits may leave between tangent
 // surfaces: each fit's vertices are off its surface by about one, either way.
 constexpr double kRoundingUnits = 4;
@@ -108,18 +109,30 @@ std::size_t exact_tangencies(const Mesh& m, const FaceMap<std::int32_t>& region,
     // Two cylinders are tangent when their gap is within what their fits leave open: each is
     // off its vertices by up to its error, an exact fit by the coordinates' rounding.
     const double rounding = kRoundingUnits * coordinate_rounding(m);
+    // How far a region's vertices reach from its axis point along its axis, either way.
+    const auto extent = [&](std::size_t r) {
+        const Surface& s = regions[r].surface;
+        double reach = 0;
+        for (const std::uint32_t v : ids[r])
+            reach = std::max(reach, std::abs(dot(m.position(VertexId(v)) - s.point, s.axis)));
+        return reach;
+    };
     std::vector<std::vector<std::size_t>> larger(nr);  // each one's tangent larger neighbours
     for (const auto& [a, b] : pairs) {
         const Surface& sa = regions[a].surface;
         const Surface& sb = regions[b].surface;
-        if (norm(cross(sa.axis, sb.axis)) > kParallel ||
-            std::abs(sa.radius - sb.radius) <= tolerance)
-            continue;
+        if (std::abs(sa.radius - sb.radius) <= tolerance) continue;
+        const double open = std::min(tolerance, error[a] + error[b] + rounding);
+        // Parallel as far as the fits tell: turned onto the other's axis, the smaller one moves
+        // by no more than they leave open at its ends.
+        const std::size_t small = sa.radius < sb.radius ? a : b;
+        const double sine = norm(cross(sa.axis, sb.axis));
+        if (sine > kParallel || sine * extent(small) > open) continue;
         const double d = norm(across(sa.point - sb.point, sb.axis));
         const double outside = d - (sa.radius + sb.radius);
         const double inside = d - std::abs(sa.radius - sb.radius);
         const double gap = std::min(std::abs(outside), std::abs(inside));
-        if (gap > std::min(tolerance, error[a] + error[b] + rounding)) continue;
+        if (gap > open) continue;
         if (sa.radius < sb.radius) {
             larger[a].push_back(b);
         } else {
@@ -146,6 +159,8 @@ std::size_t exact_tangencies(const Mesh& m, const FaceMap<std::int32_t>& region,
             // Along the larger one's axis exactly (within kParallel already).
             s.axis = dot(s.axis, o.axis) >= 0 ? o.axis : -1 * o.axis;
         }
+        // Turned by more than a hair at its ends.
+        const bool turned = norm(cross(s.axis, regions[r].surface.axis)) * extent(r) > kHair / 2;
         // Every contact's axis the same to rounding: else the gap changes along the axis, and a
         // hair at the axis point is none where a third face cuts the two.
         if (std::any_of(larger[r].begin(), larger[r].end(), [&](std::size_t n) {
@@ -175,8 +190,11 @@ std::size_t exact_tangencies(const Mesh& m, const FaceMap<std::int32_t>& region,
                 if (f(i) < -kHair / 2) apart = false;
             }
             // Cylinders apart already leave circles on a third face that do not cross: the
-            // corner bridges their gap within its tolerance, and the part stays as fitted.
-            if (step == 0 && apart) break;
+            // corner bridges their gap within its tolerance, and the part stays as fitted. Not
+            // when its axis was turned to theirs: apart at its axis point now, it was not
+            // along all its length (six-digit coordinates: axes 1e-6 apart over 10 mm, a gap
+            // of 9e-6 mm).
+            if (step == 0 && apart && !turned) break;
             if (worst <= kHair / 4) {
                 solved = true;
                 break;
