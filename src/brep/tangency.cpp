@@ -33,6 +33,9 @@ const double kHair = Precision::Confusion() / 100;
 // and by 1e-6 from six-digit coordinates (NIST FTC 06's slot arcs, 2.5 mm high); the move,
 // a turn about the axis point, is checked against the tolerance below.
 constexpr double kParallel = 1e-4;
+// Two unit directions this close (sine of their angle) are one to double rounding: a gap
+// between cylinders along them changes by under 1e-11 over 1000 mm, a hundredth of kHair.
+constexpr double kSameDirection = 1e-14;
 // Coordinate rounding units (coordinate_rounding()) two exact fits may leave between tangent
 // surfaces: each fit's vertices are off its surface by about one, either way.
 constexpr double kRoundingUnits = 4;
@@ -164,7 +167,7 @@ std::size_t exact_tangencies(const Mesh& m, const FaceMap<std::int32_t>& region,
         // Every contact's axis the same to rounding: else the gap changes along the axis, and a
         // hair at the axis point is none where a third face cuts the two.
         if (std::any_of(larger[r].begin(), larger[r].end(), [&](std::size_t n) {
-                return norm(cross(s.axis, regions[n].surface.axis)) > 1e-14;
+                return norm(cross(s.axis, regions[n].surface.axis)) > kSameDirection;
             }))
             continue;
         // Gauss-Newton in (the axis point across the axis, the radius weighted by
