@@ -190,11 +190,6 @@ bool has_no_length_loop(const TopoDS_Face& face) {
     return false;
 }
 
-Vec3 any_perpendicular(Vec3 a) {
-    const Vec3 t = std::abs(a.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-    return normalized(cross(a, t));
-}
-
 // The unit part of `v` perpendicular to the unit `axis`, or any perpendicular when too small.
 Vec3 perpendicular_part(Vec3 v, Vec3 axis) {
     const Vec3 p = v - dot(v, axis) * axis;

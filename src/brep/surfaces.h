@@ -3,6 +3,7 @@
 
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -12,6 +13,12 @@
 #include "ncrev/mesh.h"
 
 namespace ncrev::brep_detail {
+
+/// A unit vector perpendicular to the unit `a`.
+inline Vec3 any_perpendicular(Vec3 a) {
+    const Vec3 t = std::abs(a.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    return normalized(cross(a, t));
+}
 
 /// One region of the labelling: its surface, or none (`has_surface` false: the region can only
 /// be built from its facets).
@@ -104,11 +111,11 @@ SurfaceBrep build_surface_brep(const Mesh& mesh, const FaceMap<std::int32_t>& re
 /// Tangent cylinders made exact (docs/brep.md, 1): of two adjacent regions that are cylinders
 /// with parallel axes and overlap within what their fits leave open (their vertices' distances
 /// from them plus four coordinate rounding units, at most `tolerance`), the smaller is moved
-/// across its axis (its radius too only where no such move holds all its contacts) so that the
-/// two are a hair apart (1e-9: a hundredth of OpenCASCADE's smallest tolerance): a third face
-/// cutting both then has edges that do not cross beside their corner. Larger ones first; a
-/// move is kept only while the region's vertices stay within `tolerance` of its surface (or as
-/// near as before). Returns the regions moved.
+/// across its axis (its radius by a ten-thousandth as much, more only where no such move holds
+/// all its contacts) so that the two are a hair apart (1e-9: a hundredth of OpenCASCADE's smallest
+/// tolerance): a third face cutting both then has edges that do not cross beside their corner.
+/// Larger ones first; a move is kept only while the region's vertices stay within `tolerance` of
+/// its surface (or as near as before). Returns the regions moved.
 std::size_t exact_tangencies(const Mesh& mesh, const FaceMap<std::int32_t>& region,
                              std::vector<RegionSurface>& regions, double tolerance);
 

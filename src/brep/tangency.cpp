@@ -7,9 +7,10 @@
 // (r the product of the radii over their sum): NIST FTC 06's arcs of radius 22.225 and 3.175
 // overlapped by 1.3e-7 mm and crossed 8.5e-4 mm from the corner, far past its tolerance, and
 // the floor's wire crossed itself. So the smaller of two adjacent cylinders with parallel axes
-// that overlap within what their fits leave open is moved across its axis (its radius too only
-// where no such move holds all its contacts) until the two are a hair apart (kHair): circles
-// that neither cross nor touch, the corner within its tolerance of both.
+// that overlap within what their fits leave open is moved across its axis (its radius by a
+// ten-thousandth as much, more only where no such move holds all its contacts) until the two
+// are a hair apart (kHair): circles that neither cross nor touch, the corner within its
+// tolerance of both.
 #include <Eigen/Dense>
 #include <Precision.hxx>
 #include <algorithm>
@@ -39,8 +40,10 @@ constexpr double kSameDirection = 1e-14;
 // Coordinate rounding units (coordinate_rounding()) two exact fits may leave between tangent
 // surfaces: each fit's vertices are off its surface by about one, either way.
 constexpr double kRoundingUnits = 4;
-// How much more a unit of radius costs than a unit of axis move in the solve: the radius, a
-// tool's and often a round value, changes only where no move of the axis holds every contact.
+// How much more a unit of radius costs than a unit of axis move in the solve (a least change
+// in the weighted unknowns): the radius, a tool's and often a round value, takes 1/100^2 of a
+// move where the axis can hold every contact (FTC 06: 5e-10 mm for 5e-6), and the rest only
+// where it cannot (a fillet between three arcs).
 constexpr double kRadiusWeight = 100;
 // Gauss-Newton steps of the solve: its constraints are distances between axes, and it starts
 // within the tolerance of the solution.
@@ -160,7 +163,7 @@ std::size_t exact_tangencies(const Mesh& m, const FaceMap<std::int32_t>& region,
                 {o.point, o.radius,
                  std::abs(d - (o.radius - s.radius)) < std::abs(d - (o.radius + s.radius))});
             // Along the larger one's axis exactly (within kParallel already).
-            s.axis = dot(s.axis, o.axis) >= 0 ? o.axis : -1 * o.axis;
+            s.axis = dot(s.axis, o.axis) >= 0 ? o.axis : -o.axis;
         }
         // Turned by more than a hair at its ends.
         const bool turned = norm(cross(s.axis, regions[r].surface.axis)) * extent(r) > kHair / 2;
@@ -172,8 +175,7 @@ std::size_t exact_tangencies(const Mesh& m, const FaceMap<std::int32_t>& region,
             continue;
         // Gauss-Newton in (the axis point across the axis, the radius weighted by
         // kRadiusWeight), each step the least change.
-        const Vec3 u =
-            normalized(cross(s.axis, std::abs(s.axis.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
+        const Vec3 u = any_perpendicular(s.axis);
         const Vec3 w = cross(s.axis, u);
         const auto k = static_cast<Eigen::Index>(contacts.size());
         bool solved = false, apart = true;
