@@ -86,6 +86,8 @@ constexpr double kNormalOutlierArea = 0.02;
 /// the surface and whose middle is 2 deflections off is still a chord of it; one that bridges
 /// two faces (a cap triangle on a bore's rim) is off by the bore's radius.
 constexpr double kMiddleSagFactor = 2;
+/// A triangle's middle sags 4/3 as much as its edges' middles on a sphere (see kMiddleSagFactor).
+constexpr double kChordMiddleFactor = 4.0 / 3.0;
 /// A region of at most this many facets says nothing of its kind (its plane is its facets'):
 /// a ruled surface may take it with middles up to kMiddleSagFactor deflections off (see
 /// chords_agree()).
@@ -374,9 +376,40 @@ double chord_sag(const Surface& s, double len, std::span<const Vec3> corners) {
     return rho > 0 ? std::min(len * len / (8 * rho), rho) : 0;
 }
 
+/// How far the middle of facet f may lie from the B-spline s as a chord of it: as far as s
+/// bends between f's corners. An edge whose corners' normals on s turn by theta sags
+/// c theta / 8, c its length across the turn (a circle's chord of length c and angle theta
+/// sags c^2 / 8 rho = c theta / 8), and the triangle's middle 4/3 as much as its edges'
+/// middles (kChordMiddleFactor, a sphere's). 0 where an edge turns by the sharp angle or more:
+/// that facet spans an edge of s, it is no chord. A B-spline has no one radius (chord_sag()),
+/// and the deflection estimate is the part's, not the surface's where it bends most: at the end
+/// of trimesh_featuretype's spline wall meshed at 0.02 rad, facets with their corners on the
+/// wall to 0.002 mm have middles 0.032-0.050 mm off it, above twice the estimate (0.029), and
+/// within what their edges alone bend (0.034-0.093 mm; temporary print).
+double bspline_chord_sag(const Context& c, const Surface& s, std::uint32_t f) {
+    std::array<Vec3, 3> p, n;
+    for (std::size_t i = 0; i < 3; ++i) {
+        p[i] = c.m.position(c.m.vertex(fid(f), static_cast<int>(i)));
+        n[i] = normal_at(s, p[i]);
+    }
+    double edge = 0;
+    for (std::size_t i = 0; i < 3; ++i) {
+        const std::size_t j = (i + 1) % 3;
+        const double cos_turn = dot(n[i], n[j]);
+        if (!(cos_turn > std::cos(c.sharp))) return 0;
+        const Vec3 turn = n[j] - n[i];
+        const double len = norm(turn);
+        if (!(len > 0)) continue;
+        const double across = std::abs(dot(p[j] - p[i], turn / len));
+        edge = std::max(edge, across * std::acos(std::min(cos_turn, 1.0)) / 8);
+    }
+    return kChordMiddleFactor * edge;
+}
+
 /// Facet f as a chord of s where the deflection estimate is too tight: its corners within
 /// `corners` (the tolerance, or the deflection for a surface held to that), its middle no
-/// farther than a chord of its longest side across s (chord_sag()), nor than kMiddleSagFactor
+/// farther than a chord of its longest side across s (chord_sag(); on a B-spline, as far as s
+/// bends between the corners: bspline_chord_sag()), nor than kMiddleSagFactor
 /// deflections. BRepMesh's fans on the large fillets of NIST CTC 05 sag 2.1 - 3.5 x the
 /// estimate with every corner on the torus to rounding: 24 one-facet planes. Only for leftovers
 /// no neighbour takes otherwise: a cap triangle of a plane on a bore's rim is a chord of the
@@ -391,7 +424,8 @@ bool chord_fits(const Context& c, const Surface& s, std::uint32_t f, double corn
         len = std::max(len, norm(p[(i + 1) % 3] - p[i]));
     }
     const double mid = distance(s, c.fd.centroid[f]);
-    return mid <= std::max(kMiddleSagFactor * c.sag, chord_sag(s, len, p));
+    if (mid <= std::max(kMiddleSagFactor * c.sag, chord_sag(s, len, p))) return true;
+    return s.kind == FitKind::kBSpline && mid <= bspline_chord_sag(c, s, f);
 }
 
 /// Facet f's smallest height: twice its area over its longest side.
@@ -445,7 +479,8 @@ enum class RuledSag {
 /// The facets are chords of s: every middle within the sag, and the normals close to s's,
 /// except on at most kNormalOutlierArea of the area (slivers: a thin triangle whose corners lie
 /// on one circle of a torus has that circle's plane, whatever the torus's normal there).
-/// A B-spline is itself held only to the sag at the vertices: its chords' middles get twice.
+/// A B-spline is itself held only to the sag at the vertices: its chords' middles get twice,
+/// or as far as it bends between their corners where that is more (bspline_chord_sag()).
 /// So may a cylinder's and a cone's with `ruled_sag` (RuledSag) where no sharp edge runs between
 /// the facets: facets from rim to rim of a wide drafted wall (NIST CTC 02's cones of radius 101
 /// at 3 degrees) have generators for edges, which show no sag, and their middles sag 1.6 x the
@@ -469,7 +504,7 @@ bool chords_agree(const Context& c, const Surface& s, std::span<const std::uint3
     bool beyond = false;  // a middle beyond the sag, within twice (a ruled surface)
     for (const std::uint32_t f : faces) {
         const double d = distance(s, c.fd.centroid[f]);
-        if (d > limit) {
+        if (d > limit && !(s.kind == FitKind::kBSpline && d <= bspline_chord_sag(c, s, f))) {
             if (!ruled || d > kMiddleSagFactor * c.sag) return false;
             if (ruled_sag == RuledSag::kOwnEdges && d > kSagFactor * c.facet_sag[f]) return false;
             beyond = true;
@@ -1396,8 +1431,6 @@ bool extrusion_pays(const FitResult& r, const Pieces& whole) {
 /// quantile of the curved edges' sags). A faceted cut's chord vertices lie at up to a quarter of
 /// the estimate (crossed 12- to 120-sided bores: faceted_cut_test.cpp), the angle block's 0.4.
 double chord_depth(const Context& c) { return c.sag / kSagFactor; }
-/// A triangle's middle sags 4/3 as much as its edges' middles on a sphere (see kMiddleSagFactor).
-constexpr double kChordMiddleFactor = 4.0 / 3.0;
 
 /// A fit of a cylinder, cone or sphere to the vertices of `faces` that may lie inside it by up
 /// to chord_depth(): the vertices more than the tolerance inside are left out of the
