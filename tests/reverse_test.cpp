@@ -46,6 +46,7 @@
 #include <string>
 #include <vector>
 
+#include "analytic_shapes.h"
 #include "ncrev/brep.h"
 #include "ncrev/fit.h"
 #include "ncrev/io.h"
@@ -832,6 +833,31 @@ TEST(ReverseSurfaces, FineRealPartKeepsItsFaces) {
     // 2 % short with every corner solved plainly; 0.2 % where one chain's ends, past the
     // contact on the fillet's first row, still need it.
     EXPECT_NEAR(curved, true_curved, 5e-3 * true_curved);
+}
+
+// trimesh_featuretype meshed as the time benchmark meshes it (1e-3 of its size and 0.02 rad,
+// 81.6k facets, float32 as an STL stores them): its spline pocket wall bends 5 x as sharply at
+// one end as the part's curved edges, and that end came back as seven analytic pieces (a torus
+// of 42 facets, a cone of 37, bands of a few rows fitted to rounding) and one-facet planes whose
+// middles sag past twice the deflection estimate: 90 faces, a one-facet plane cut off from the
+// wall a fallback. A facet is now a B-spline's chord when its middle is off no more than the
+// surface bends between its corners (bspline_chord_sag()), and the wall, a surface known far
+// better than the deflection (29k facets), takes the exact pieces whose vertices it holds within
+// the tolerance (widen_freeform()): 84 faces for 79 (its split cylinder halves unified), none
+// falls back.
+TEST(ReverseSurfaces, ASplineWallKeepsItsSharplyBentEnd) {
+    const auto path = corpus_step_dir() / "trimesh_featuretype.step";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;
+    SampleOptions so;
+    so.with_step = false;
+    so.relative_deflection = 1e-3;
+    so.angular_deflection = 0.02;
+    Result<SamplePart> made = sample_from_step(path, so);
+    ASSERT_TRUE(made.ok()) << made.error().describe();
+    test::round_to_float(made.value().mesh.points);
+    const Outcome o = reverse_part(made.value(), false, ReverseMethod::kAuto, "featuretype_fine");
+    expect_exact(o, "featuretype_fine");
+    EXPECT_LE(o.report.faces, 86u);  // 79 + 10 %
 }
 
 // The table of docs/results.md:

@@ -2477,14 +2477,16 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
     for (std::uint32_t r = 0; r < drafts.size(); ++r)
         if (freeform(r)) seeds.push_back(r);
     if (seeds.empty()) return grown;
-    // A piece: analytic as its final fit left it.
-    const auto piece = [&](std::uint32_t r) {
+    // Analytic as its final fit left it.
+    const auto analytic = [&](std::uint32_t r) {
         const Draft& d = drafts[r];
-        if (!d.alive || stale[r] || d.surface_index >= 0 || d.loose > 0 || d.faces.empty() ||
-            d.surface.kind == FitKind::kBSpline || !fitted[r].fit.ok ||
-            fitted[r].fit.surface.kind == FitKind::kBSpline)
-            return false;
-        return fitted[r].fit.rms > kLooseRms * c.sag;
+        return d.alive && !stale[r] && d.surface_index < 0 && d.loose <= 0 && !d.faces.empty() &&
+               d.surface.kind != FitKind::kBSpline && fitted[r].fit.ok &&
+               fitted[r].fit.surface.kind != FitKind::kBSpline;
+    };
+    // A piece: analytic and loose.
+    const auto piece = [&](std::uint32_t r) {
+        return analytic(r) && fitted[r].fit.rms > kLooseRms * c.sag;
     };
     std::stable_sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
         return drafts[a].faces.size() > drafts[b].faces.size();
@@ -2510,7 +2512,7 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
                     const std::uint32_t g = c.fd.adj[f][i];
                     if (g == kNone || c.sharp_edge[3 * f + i]) continue;
                     const std::uint32_t n = region[g];
-                    if (n == kNone || mark[n] == s || !piece(n)) continue;
+                    if (n == kNone || mark[n] == s || !(large ? analytic(n) : piece(n))) continue;
                     mark[n] = s;
                     frontier.push(n);
                 }
@@ -2531,9 +2533,13 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
             if (large) {
                 // A large region's surface is known far better than the deflection, and a refit
                 // costs every one of its points (0.25 s for 29k facets of trimesh_featuretype's
-                // spline wall, three times over).
-                if (farthest_corner(c, so_far, pf) > c.sag || !chords_agree(c, so_far, pf))
-                    continue;
+                // spline wall, three times over). So it takes a piece as it is, or not at all:
+                // a loose one within the deflection, an exact one within the tolerance, as an
+                // analytic region holds its vertices (a band of a few rows fits a torus or cone
+                // of its own to rounding: the end of that wall in seven such pieces, its vertices
+                // within 0.005 mm of the wall, the tolerance 0.015 mm).
+                const double hold = piece(n) ? c.sag : c.tol;
+                if (farthest_corner(c, so_far, pf) > hold || !chords_agree(c, so_far, pf)) continue;
                 r.ok = true;
                 r.surface = so_far;
             } else {
@@ -2548,8 +2554,13 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
             // The piece's facets within the deflection at their middles too, not the twice a
             // B-spline's chords may sag: a net stretched over pieces at its border bulged
             // between their vertices (the link rods' solid 2.4 deflections from the mesh).
+            // A large region's surface is its own, not stretched over the piece: its middles may
+            // sag as far as that surface bends between their corners (bspline_chord_sag(); the
+            // wall's end bends 5 x as sharply as the part's curved edges, its pieces' middles
+            // 0.03-0.09 mm off it, the deflection 0.015 mm).
             if (std::any_of(pf.begin(), pf.end(), [&](std::uint32_t f) {
-                    return distance(r.surface, c.fd.centroid[f]) > c.sag;
+                    const double d = distance(r.surface, c.fd.centroid[f]);
+                    return d > c.sag && !(large && d <= bspline_chord_sag(c, r.surface, f));
                 }))
                 continue;
             so_far = r.surface;
