@@ -835,6 +835,102 @@ TEST(ReverseSurfaces, FineRealPartKeepsItsFaces) {
     EXPECT_NEAR(curved, true_curved, 5e-3 * true_curved);
 }
 
+// Two parts side by side in one mesh (an STL of several parts, or a workpiece cut in two): two
+// components, each its own solid. Until the shell was split by its connected faces, the two
+// came back as one shell that OpenCASCADE finds not connected, the planar method's too, and
+// nothing was written.
+TEST(ReverseSurfaces, PartsSideBySideAreSolidsOfTheirOwn) {
+    const SamplePart one = make("drilled_plate", kFine);
+    SamplePart two = one;
+    two.step.clear();
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Vec3& p : one.mesh.points) lo = std::min(lo, p.x), hi = std::max(hi, p.x);
+    const double shift = 1.2 * (hi - lo);  // a gap of a fifth of the part's length
+    const auto base = static_cast<std::uint32_t>(one.mesh.points.size());
+    for (const Vec3& p : one.mesh.points) two.mesh.points.push_back({p.x + shift, p.y, p.z});
+    for (const auto& t : one.mesh.triangles)
+        two.mesh.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    two.mesh.color.clear();
+    two.mesh.cut.clear();
+    two.mesh.surface.clear();
+    two.faces.insert(two.faces.end(), one.faces.begin(), one.faces.end());
+    two.solid.volume = 2 * one.solid.volume;
+    for (const ReverseMethod method : {ReverseMethod::kAuto, ReverseMethod::kPlanar}) {
+        const std::string tag = method == ReverseMethod::kAuto ? "two_plates" : "two_plates_planar";
+        const Outcome o = reverse_part(two, false, method, tag);
+        EXPECT_TRUE(o.report.written) << tag;
+        EXPECT_TRUE(o.report.solid && o.report.valid) << tag;
+        EXPECT_EQ(o.report.bodies, 2u) << tag;
+        EXPECT_TRUE(o.back.valid) << tag;
+        EXPECT_EQ(o.back.solids, 2u) << tag;
+        EXPECT_EQ(o.back.faces, o.report.faces) << tag;
+        EXPECT_NEAR(o.back.volume, two.solid.volume, 1e-3 * two.solid.volume) << tag;
+        if (method == ReverseMethod::kAuto) {
+            EXPECT_TRUE(o.report.fallbacks.empty()) << tag;
+            EXPECT_EQ(o.report.faces, two.faces.size()) << tag;
+        }
+    }
+}
+
+// A closed part inside another (a cavity's shell, or a part inside a part) is not built yet:
+// healing turns every closed component outward, so a cavity would come back as a solid of its
+// own filling it. Refused with the reason, nothing written; side by side the same cubes build.
+TEST(ReverseSurfaces, ANestedPartIsRefusedNotFilled) {
+    const auto cubes = [](double inner_offset) {
+        TriangleSoup soup;
+        const auto cube = [&](Vec3 lo, Vec3 hi, bool inward) {
+            const auto base = static_cast<std::uint32_t>(soup.points.size());
+            for (int k = 0; k < 8; ++k) {
+                soup.points.push_back(
+                    {k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z});
+            }
+            // Outward: counter-clockwise seen from outside.
+            const std::array<std::array<std::uint32_t, 4>, 6> quads{{{0, 2, 3, 1},
+                                                                     {4, 5, 7, 6},
+                                                                     {0, 1, 5, 4},
+                                                                     {2, 6, 7, 3},
+                                                                     {0, 4, 6, 2},
+                                                                     {1, 3, 7, 5}}};
+            for (const auto& q : quads) {
+                for (const auto& t : {std::array<std::uint32_t, 3>{q[0], q[1], q[2]},
+                                      std::array<std::uint32_t, 3>{q[0], q[2], q[3]}}) {
+                    if (inward)
+                        soup.triangles.push_back({base + t[0], base + t[2], base + t[1]});
+                    else
+                        soup.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+                }
+            }
+        };
+        cube({0, 0, 0}, {10, 10, 10}, false);
+        cube({3 + inner_offset, 3, 3}, {7 + inner_offset, 7, 7}, inner_offset == 0);
+        return soup;
+    };
+    for (const ReverseMethod method : {ReverseMethod::kAuto, ReverseMethod::kPlanar}) {
+        const auto path = out_dir() / "nested_cubes.step";
+        std::filesystem::remove(path);
+        Result<BuildResult> nested = build_mesh(cubes(0));
+        ASSERT_TRUE(nested.ok());
+        ReverseOptions ro;
+        ro.method = method;
+        const Result<ReverseReport> refused = reverse_to_step(nested->mesh, path, ro);
+        ASSERT_TRUE(refused.ok());
+        EXPECT_FALSE(refused->written);
+        EXPECT_FALSE(std::filesystem::exists(path));
+        ASSERT_FALSE(refused->warnings.empty());
+        EXPECT_NE(refused->warnings.back().find("inside"), std::string::npos)
+            << refused->warnings.back();
+        Result<BuildResult> apart = build_mesh(cubes(20));  // the small cube beside the large
+        ASSERT_TRUE(apart.ok());
+        const Result<ReverseReport> built = reverse_to_step(apart->mesh, path, ro);
+        ASSERT_TRUE(built.ok());
+        EXPECT_TRUE(built->written && built->valid);
+        EXPECT_EQ(built->bodies, 2u);
+        EXPECT_EQ(built->faces, 12u);
+        EXPECT_NEAR(built->solid_volume, 1000 + 64, 1e-6);
+        std::filesystem::remove(path);
+    }
+}
+
 // trimesh_featuretype meshed as the time benchmark meshes it (1e-3 of its size and 0.02 rad,
 // 81.6k facets, float32 as an STL stores them): its spline pocket wall bends 5 x as sharply at
 // one end as the part's curved edges, and that end came back as seven analytic pieces (a torus

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <map>
 #include <span>
+#include <string>
 
 #include "commands.h"
 #include "ncrev/brep.h"
@@ -179,7 +180,9 @@ void add_reverse(CLI::App& app, Context& ctx) {
             for (const std::string& w : rev->warnings) print_warning(w);
         }
         if (!rev->written) {
-            print_error(o->input + ": the B-rep is not a valid shape; nothing written");
+            print_error(
+                o->input + ": no valid B-rep; nothing written" +
+                (rev->warnings.empty() || o->quiet ? std::string() : " (see the warnings above)"));
             ctx.exit_code = kExitNoResult;
             return;
         }
@@ -188,11 +191,15 @@ void add_reverse(CLI::App& app, Context& ctx) {
             for (const auto& [kind, n] : rev->faces_by_kind) {
                 kinds += (kinds.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
             }
+            const std::string bodies =
+                rev->bodies > 1
+                    ? std::to_string(rev->bodies) + (rev->solid ? " closed solids" : " open shells")
+                : rev->solid ? "closed solid"
+                             : "open shell";
             std::fprintf(stderr, "%s: %llu faces (%s), %llu edges, %llu vertices, %s, %llu bytes\n",
                          o->output.c_str(), static_cast<unsigned long long>(rev->faces),
                          kinds.c_str(), static_cast<unsigned long long>(rev->edges),
-                         static_cast<unsigned long long>(rev->vertices),
-                         rev->solid ? "closed solid" : "open shell",
+                         static_cast<unsigned long long>(rev->vertices), bodies.c_str(),
                          static_cast<unsigned long long>(rev->step_bytes));
         }
         ctx.exit_code = kExitOk;

@@ -100,7 +100,10 @@ struct ReverseReport {
     std::string planar_tolerance_rule;                          ///< how it was chosen
     std::map<std::string, std::uint64_t> faces_by_kind;         ///< e.g. {"plane": 12}
     std::uint64_t faces = 0, edges = 0, vertices = 0;
-    bool solid = false;         ///< a closed shell was made into a solid
+    bool solid = false;  ///< the closed shells were made into solids
+    /// Bodies: connected shells, one per component of the mesh (several parts side by side
+    /// give several), each a solid when closed; written as that many solids (or shells).
+    std::uint64_t bodies = 0;
     bool valid = false;         ///< the structural check (and BRepCheck_Analyzer) found no defect
     bool occt_checked = false;  ///< BRepCheck_Analyzer ran too (B-reps of up to 5000 faces)
     double solid_volume = 0, solid_area = 0;  ///< of the B-rep's faces

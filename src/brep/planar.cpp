@@ -20,6 +20,7 @@
 #include <Geom_Plane.hxx>
 #include <Precision.hxx>
 #include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shell.hxx>
@@ -46,6 +47,39 @@ double distance_to_segment(Vec3 p, Vec3 a, Vec3 b) {
     if (len2 == 0) return norm(p - a);
     const double t = std::clamp(dot(p - a, ab) / len2, 0.0, 1.0);
     return norm(p - (a + t * ab));
+}
+
+/// Fills topo.body and topo.bodies: faces that share a segment are one body (union-find).
+void number_bodies(PlanarTopology& topo) {
+    const std::size_t nf = topo.faces.size();
+    std::vector<std::uint32_t> parent(nf);
+    for (std::uint32_t f = 0; f < nf; ++f) parent[f] = f;
+    const auto root = [&](std::uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    std::vector<std::uint32_t> face_of_segment(topo.segments.size(), kNone);
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        for (const PlanarTopology::Loop& loop : topo.faces[f].loops) {
+            for (const auto& [seg, forward] : loop.edges) {
+                std::uint32_t& other = face_of_segment[seg];
+                if (other == kNone) {
+                    other = f;
+                } else {
+                    const std::uint32_t a = root(other), b = root(f);
+                    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+                }
+            }
+        }
+    }
+    topo.body.assign(nf, kNone);
+    std::vector<std::uint32_t> number(nf, kNone);
+    topo.bodies = 0;
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        std::uint32_t& n = number[root(f)];
+        if (n == kNone) n = topo.bodies++;
+        topo.body[f] = n;
+    }
 }
 
 }  // namespace
@@ -305,6 +339,7 @@ PlanarTopology planar_topology(const Mesh& m, bool merge, double tol) {
     for (std::size_t hi = 0; hi < nh && out.closed; ++hi) {
         out.closed = !m.is_boundary(HalfedgeId(static_cast<std::uint32_t>(hi)));
     }
+    number_bodies(out);
     return out;
 }
 
@@ -394,9 +429,10 @@ PlanarShape to_occt(const PlanarTopology& topo, const Mesh& m) {
         builder.Add(edge[s], vertex_of(topo.segments[s][1]).Oriented(TopAbs_REVERSED));
         builder.Range(edge[s], 0.0, norm(b - a));
     }
-    TopoDS_Shell shell;
-    builder.MakeShell(shell);
-    for (const PlanarTopology::Face& f : topo.faces) {
+    std::vector<TopoDS_Shell> shells(topo.bodies);
+    for (TopoDS_Shell& shell : shells) builder.MakeShell(shell);
+    for (std::size_t k = 0; k < topo.faces.size(); ++k) {
+        const PlanarTopology::Face& f = topo.faces[k];
         Handle(Geom_Plane) plane =
             new Geom_Plane(pnt(f.origin), gp_Dir(f.normal.x, f.normal.y, f.normal.z));
         TopoDS_Face face;
@@ -410,17 +446,28 @@ PlanarShape to_occt(const PlanarTopology& topo, const Mesh& m) {
             wire.Closed(true);
             builder.Add(face, wire);
         }
-        builder.Add(shell, face);
+        builder.Add(shells[topo.body[k]], face);
     }
-    shell.Closed(topo.closed);
-    if (topo.closed) {
-        TopoDS_Solid solid;
-        builder.MakeSolid(solid);
-        builder.Add(solid, shell);
-        out.shape = solid;
-        out.solid = true;
+    std::vector<TopoDS_Shape> bodies;
+    for (TopoDS_Shell& shell : shells) {
+        shell.Closed(topo.closed);
+        if (topo.closed) {
+            TopoDS_Solid solid;
+            builder.MakeSolid(solid);
+            builder.Add(solid, shell);
+            bodies.push_back(solid);
+        } else {
+            bodies.push_back(shell);
+        }
+    }
+    out.solid = topo.closed;
+    if (bodies.size() == 1) {
+        out.shape = bodies.front();
     } else {
-        out.shape = shell;
+        TopoDS_Compound all;
+        builder.MakeCompound(all);
+        for (const TopoDS_Shape& b : bodies) builder.Add(all, b);
+        out.shape = all;
     }
     return out;
 }

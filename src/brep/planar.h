@@ -29,7 +29,12 @@ struct PlanarTopology {
     std::vector<std::array<std::uint32_t, 2>> segments;  ///< mesh vertex ids, start -> end
     std::vector<Face> faces;
     double tolerance = 0;  ///< largest deviation of a vertex from its face plane or segment
-    bool closed = false;   ///< the mesh is closed: the shell bounds a solid
+    bool closed = false;   ///< the mesh is closed: each shell bounds a solid
+    /// Per face, its body: the connected shell it belongs to (faces joined by shared
+    /// segments), numbered from 0 in the order of their first face. A mesh of several
+    /// components (parts side by side) has several bodies, each a shell (a solid when closed).
+    std::vector<std::uint32_t> body;
+    std::uint32_t bodies = 0;
 };
 
 /// `merge` false: one face per facet (the paper's method 1). `merge` true: coplanar
@@ -49,7 +54,8 @@ void measure_topology(const PlanarTopology& topology, const Mesh& mesh, double& 
                       double& volume);
 
 struct PlanarShape {
-    TopoDS_Shape shape;  ///< a solid when the mesh is closed, else a shell
+    TopoDS_Shape shape;  ///< a solid per body when the mesh is closed, else a shell per body;
+                         ///< several in a compound
     bool solid = false;
 };
 

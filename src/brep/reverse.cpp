@@ -8,11 +8,13 @@
 #include <Standard_Failure.hxx>
 #include <TopExp.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <string>
 
 #include "brep/check.h"
 #include "brep/deviation.h"
@@ -181,6 +183,7 @@ Result<ReverseReport> reverse_planar(const Mesh& mesh, const MeshStats& stats,
     }
     rep.faces_by_kind["plane"] = rep.faces;
     rep.solid = topo.closed;
+    rep.bodies = topo.bodies;
     std::string problem;
     try {
         stage("check", [&] {
@@ -537,6 +540,9 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             TopExp::MapShapes(brep.shape, TopAbs_FACE, faces);
             TopExp::MapShapes(brep.shape, TopAbs_EDGE, edges);
             TopExp::MapShapes(brep.shape, TopAbs_VERTEX, vertices);
+            TopTools_IndexedMapOfShape bodies;
+            TopExp::MapShapes(brep.shape, brep.solid ? TopAbs_SOLID : TopAbs_SHELL, bodies);
+            rep.bodies = static_cast<std::uint64_t>(bodies.Extent());
             rep.faces = static_cast<std::uint64_t>(faces.Extent());
             rep.edges = static_cast<std::uint64_t>(edges.Extent());
             rep.vertices = static_cast<std::uint64_t>(vertices.Extent());
@@ -653,7 +659,9 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
                     deviation = brep_detail::measure_deviation(brep.shape, mesh, deflection);
                 });
             }
-            if (verify) back = brep_detail::step_read_back(output);
+            if (verify) {
+                back = brep_detail::step_read_back(output, static_cast<int>(rep.bodies));
+            }
             measuring.wait();
         });
         const std::string& back_problem = back.problem;
@@ -691,6 +699,108 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     }
 }
 
+// Ray-triangle tests nested_component() makes at most (about a second): a part with thousands
+// of small loose components in its box would otherwise cost components x facets.
+constexpr std::uint64_t kNestingWork = 300'000'000;
+
+// A closed component of `mesh` that lies inside another (a cavity), if any: "component A
+// lies inside component B", else empty. Healing turns every closed component outward, so a
+// cavity's shell would come back as a solid of its own filling it; nested bodies are not
+// built yet. Components by shared edges; a component is inside another when a ray from one of
+// its vertices crosses the other's facets an odd number of times (the majority of three
+// rays, for rays that graze an edge), tested only where its box lies in the other's.
+// `skipped`: set when the check stopped at kNestingWork (nothing found so far).
+std::string nested_component(const Mesh& mesh, const MeshStats& stats, bool* skipped) {
+    if (stats.components < 2) return {};
+    const std::uint32_t nf = mesh.num_faces();
+    constexpr std::uint32_t kUnset = 0xFFFFFFFFu;
+    std::vector<std::uint32_t> comp(nf, kUnset);
+    std::vector<std::uint32_t> stack;
+    std::uint32_t count = 0;
+    for (std::uint32_t f0 = 0; f0 < nf; ++f0) {
+        if (comp[f0] != kUnset) continue;
+        comp[f0] = count;
+        stack.assign(1, f0);
+        while (!stack.empty()) {
+            const std::uint32_t f = stack.back();
+            stack.pop_back();
+            for (int i = 0; i < 3; ++i) {
+                const HalfedgeId t = mesh.twin(Mesh::halfedge(FaceId(f), i));
+                if (!t.is_valid()) continue;
+                const std::uint32_t g = Mesh::face(t).idx();
+                if (comp[g] != kUnset) continue;
+                comp[g] = count;
+                stack.push_back(g);
+            }
+        }
+        ++count;
+    }
+    if (count < 2) return {};
+    constexpr double kBig = std::numeric_limits<double>::infinity();
+    struct Box {
+        Vec3 lo{kBig, kBig, kBig}, hi{-kBig, -kBig, -kBig};
+        Vec3 seed;
+        bool seeded = false;
+    };
+    std::vector<Box> box(count);
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        Box& b = box[comp[f]];
+        for (int i = 0; i < 3; ++i) {
+            const Vec3 p = mesh.position(mesh.vertex(FaceId(f), i));
+            b.lo = {std::min(b.lo.x, p.x), std::min(b.lo.y, p.y), std::min(b.lo.z, p.z)};
+            b.hi = {std::max(b.hi.x, p.x), std::max(b.hi.y, p.y), std::max(b.hi.z, p.z)};
+            if (!b.seeded) b.seed = p, b.seeded = true;
+        }
+    }
+    const auto inside_box = [](const Box& a, const Box& b) {
+        return a.lo.x >= b.lo.x && a.lo.y >= b.lo.y && a.lo.z >= b.lo.z && a.hi.x <= b.hi.x &&
+               a.hi.y <= b.hi.y && a.hi.z <= b.hi.z;
+    };
+    // Directions no mesh of a machined part lines up with.
+    const std::array<Vec3, 3> rays{normalized(Vec3{0.5773, 0.4082, 0.7071}),
+                                   normalized(Vec3{-0.3162, 0.8944, 0.3169}),
+                                   normalized(Vec3{0.6325, -0.2236, -0.7416})};
+    std::vector<std::vector<std::uint32_t>> facets(count);
+    for (std::uint32_t f = 0; f < nf; ++f) facets[comp[f]].push_back(f);
+    std::uint64_t work = 0;
+    for (std::uint32_t a = 0; a < count; ++a) {
+        for (std::uint32_t b = 0; b < count; ++b) {
+            if (a == b || !inside_box(box[a], box[b])) continue;
+            work += rays.size() * facets[b].size();
+            if (work > kNestingWork) {
+                if (skipped) *skipped = true;
+                return {};
+            }
+            int odd = 0;
+            for (const Vec3& d : rays) {
+                std::uint64_t hits = 0;
+                const Vec3 o = box[a].seed;
+                for (const std::uint32_t f : facets[b]) {
+                    const Vec3 p0 = mesh.position(mesh.vertex(FaceId(f), 0));
+                    const Vec3 e1 = mesh.position(mesh.vertex(FaceId(f), 1)) - p0;
+                    const Vec3 e2 = mesh.position(mesh.vertex(FaceId(f), 2)) - p0;
+                    const Vec3 q = cross(d, e2);
+                    const double det = dot(e1, q);
+                    if (det == 0) continue;
+                    const Vec3 s = o - p0;
+                    const double u = dot(s, q) / det;
+                    if (u < 0 || u > 1) continue;
+                    const Vec3 r = cross(s, e1);
+                    const double v = dot(d, r) / det;
+                    if (v < 0 || u + v > 1) continue;
+                    if (dot(e2, r) / det > 0) ++hits;
+                }
+                odd += static_cast<int>(hits % 2);
+            }
+            if (2 * odd > static_cast<int>(rays.size())) {
+                return "component " + std::to_string(a) + " lies inside component " +
+                       std::to_string(b);
+            }
+        }
+    }
+    return {};
+}
+
 }  // namespace
 
 Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::path& output,
@@ -708,6 +818,19 @@ Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::p
     const MeshStats stats = compute_stats(mesh);
     rep.mesh_volume = stats.volume;
     rep.mesh_area = stats.area;
+    bool unchecked = false;
+    const std::string nested = nested_component(mesh, stats, &unchecked);
+    if (unchecked) {
+        rep.warnings.push_back(
+            "too many components to check whether one lies inside another (a cavity, which "
+            "would be built as a solid of its own)");
+    }
+    if (!nested.empty()) {
+        rep.warnings.push_back("the mesh has a closed part inside another (" + nested +
+                               ": a cavity, or a part inside a part); nested bodies are not "
+                               "built yet: nothing written");
+        return rep;
+    }
     const bool surfaces =
         options.method == ReverseMethod::kAuto || options.method == ReverseMethod::kSurfaces;
     if (surfaces && stats.closed) return reverse_surfaces(mesh, stats, output, options, rep);

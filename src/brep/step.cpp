@@ -176,7 +176,7 @@ Status write_step_file(const TopoDS_Shape& shape, const std::filesystem::path& p
     return Ok{};
 }
 
-ReadBack step_read_back(const std::filesystem::path& path) {
+ReadBack step_read_back(const std::filesystem::path& path, int expected_solids) {
     silence_occt();
     ReadBack out;
     const auto place = [&](const gp_Pnt& p) {
@@ -192,7 +192,10 @@ ReadBack step_read_back(const std::filesystem::path& path) {
         const TopoDS_Shape shape = reader.OneShape();
         TopTools_IndexedMapOfShape solids;
         TopExp::MapShapes(shape, TopAbs_SOLID, solids);
-        if (solids.Extent() != 1) out.problem = std::to_string(solids.Extent()) + " solids";
+        if (solids.Extent() != expected_solids) {
+            out.problem =
+                std::to_string(solids.Extent()) + " solids for " + std::to_string(expected_solids);
+        }
         // Edges of one face only (not seams): where the reader's healing opened the shell.
         TopTools_IndexedDataMapOfShapeListOfShape edge_faces;
         TopExp::MapShapesAndUniqueAncestors(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces);

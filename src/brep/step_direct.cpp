@@ -314,13 +314,20 @@ Status write_planar_step(const PlanarTopology& topo, const Mesh& m,
         st.raw(",.T.);\n");
         if (auto s = st.flush_if_large(*file); !s) return s;
     }
-    const auto shell = st.begin();
-    st.raw(topo.closed ? "CLOSED_SHELL('',(" : "OPEN_SHELL('',(");
-    for (std::size_t k = 0; k < faces.size(); ++k) {
-        if (k) st.raw(k % 16 == 0 ? ",\n" : ",");
-        st.ref(faces[k]);
+    // A shell per body (a mesh of several components: parts side by side), each a solid when
+    // closed; an open mesh's shells in one surface model.
+    std::vector<std::vector<std::size_t>> members(topo.bodies);
+    for (std::size_t k = 0; k < faces.size(); ++k) members[topo.body[k]].push_back(k);
+    std::vector<std::uint64_t> shells;
+    for (const auto& of : members) {
+        shells.push_back(st.begin());
+        st.raw(topo.closed ? "CLOSED_SHELL('',(" : "OPEN_SHELL('',(");
+        for (std::size_t k = 0; k < of.size(); ++k) {
+            if (k) st.raw(k % 16 == 0 ? ",\n" : ",");
+            st.ref(faces[of[k]]);
+        }
+        st.raw("));\n");
     }
-    st.raw("));\n");
     const auto origin = st.point({0, 0, 0});
     const auto z = st.direction({0, 0, 1});
     const auto xdir = st.direction({1, 0, 0});
@@ -332,22 +339,31 @@ Status write_planar_step(const PlanarTopology& topo, const Mesh& m,
     st.raw(",");
     st.ref(xdir);
     st.raw(");\n");
-    const auto body = st.begin();
+    std::vector<std::uint64_t> bodies;
     if (topo.closed) {
-        st.raw("MANIFOLD_SOLID_BREP(" + name + ",");
-        st.ref(shell);
-        st.raw(");\n");
+        for (const auto& shell : shells) {
+            bodies.push_back(st.begin());
+            st.raw("MANIFOLD_SOLID_BREP(" + name + ",");
+            st.ref(shell);
+            st.raw(");\n");
+        }
     } else {
+        bodies.push_back(st.begin());
         st.raw("SHELL_BASED_SURFACE_MODEL(" + name + ",(");
-        st.ref(shell);
+        for (std::size_t k = 0; k < shells.size(); ++k) {
+            if (k) st.raw(",");
+            st.ref(shells[k]);
+        }
         st.raw("));\n");
     }
     const auto rep = st.begin();
     st.raw(topo.closed ? "ADVANCED_BREP_SHAPE_REPRESENTATION("
                        : "MANIFOLD_SURFACE_SHAPE_REPRESENTATION(");
     st.raw(name + ",(");
-    st.ref(body);
-    st.raw(",");
+    for (const auto& body : bodies) {
+        st.ref(body);
+        st.raw(",");
+    }
     st.ref(placement);
     st.raw("),");
     st.ref(ctx);

@@ -69,6 +69,7 @@
 #include <TopTools_IndexedDataMapOfShapeListOfShape.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Iterator.hxx>
 #include <TopoDS_Shell.hxx>
@@ -81,6 +82,7 @@
 #include <cstdint>
 #include <map>
 #include <numbers>
+#include <numeric>
 #include <optional>
 #include <tuple>
 #include <unordered_map>
@@ -1901,6 +1903,60 @@ struct GeometryCache {
     std::uint64_t next_id = 1;
 };
 
+/// The closed shell `shell` as solids, one per connected piece (faces joined by shared edges):
+/// a mesh of several components (parts side by side) gives several, in a compound; one gives
+/// the solid of `shell` itself. Each face keeps its orientation in the shell.
+TopoDS_Shape solids_of(const TopoDS_Shell& shell) {
+    BRep_Builder B;
+    std::vector<TopoDS_Shape> members;
+    for (TopoDS_Iterator it(shell); it.More(); it.Next()) members.push_back(it.Value());
+    TopTools_IndexedMapOfShape index;  // faces, orientation aside
+    for (const TopoDS_Shape& f : members) index.Add(f);
+    std::vector<int> parent(static_cast<std::size_t>(index.Extent()) + 1);
+    std::iota(parent.begin(), parent.end(), 0);
+    const auto root = [&](int x) {
+        while (parent[static_cast<std::size_t>(x)] != x) {
+            x = parent[static_cast<std::size_t>(x)] =
+                parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+        }
+        return x;
+    };
+    TopTools_IndexedDataMapOfShapeListOfShape edge_faces;
+    TopExp::MapShapesAndUniqueAncestors(shell, TopAbs_EDGE, TopAbs_FACE, edge_faces);
+    for (int i = 1; i <= edge_faces.Extent(); ++i) {
+        int first = 0;
+        for (const TopoDS_Shape& f : edge_faces.FindFromIndex(i)) {
+            const int k = index.FindIndex(f);
+            if (k == 0) continue;
+            if (first == 0) {
+                first = k;
+                continue;
+            }
+            const int a = root(first), b = root(k);
+            if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+        }
+    }
+    std::map<int, TopoDS_Shell> pieces;  // by root: the smallest index of a piece's faces
+    for (const TopoDS_Shape& f : members) {
+        const int r = root(index.FindIndex(f));
+        auto [it, fresh] = pieces.try_emplace(r);
+        if (fresh) B.MakeShell(it->second);
+        B.Add(it->second, f);
+    }
+    const auto solid_of = [&](TopoDS_Shell sh) {
+        sh.Closed(true);
+        TopoDS_Solid solid;
+        B.MakeSolid(solid);
+        B.Add(solid, sh);
+        return solid;
+    };
+    if (pieces.size() <= 1) return solid_of(shell);
+    TopoDS_Compound all;
+    B.MakeCompound(all);
+    for (const auto& [r, sh] : pieces) B.Add(all, solid_of(sh));
+    return all;
+}
+
 }  // namespace
 
 SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& region,
@@ -3095,14 +3151,7 @@ SurfaceBrep build_surface_brep(const Mesh& m, const FaceMap<std::int32_t>& regio
             ShapeFix_Edge().FixSameParameter(TopoDS::Edge(x.Current()));
         }
         TopoDS_Shape result = fixed;
-        if (closed) {
-            TopoDS_Shell sh = TopoDS::Shell(fixed);
-            sh.Closed(true);
-            TopoDS_Solid solid;
-            B.MakeSolid(solid);
-            B.Add(solid, sh);
-            result = solid;
-        }
+        if (closed) result = solids_of(TopoDS::Shell(fixed));
         out.shape = result;
         out.solid = closed;
         std::vector<TopoDS_Shape> bad = open_faces;

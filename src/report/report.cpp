@@ -170,6 +170,7 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
                     {"edges", rev.edges},
                     {"vertices", rev.vertices},
                     {"solid", rev.solid},
+                    {"bodies", rev.bodies},
                     {"valid", rev.valid},
                     {"occt_checked", rev.occt_checked},
                     {"closed_valid_solid", rev.solid && rev.valid},
