@@ -919,6 +919,16 @@ TEST(ReverseSurfaces, ANestedPartIsRefusedNotFilled) {
         ASSERT_FALSE(refused->warnings.empty());
         EXPECT_NE(refused->warnings.back().find("inside"), std::string::npos)
             << refused->warnings.back();
+        // An open sheet inside is no cavity (no inside to count): built, as open shells.
+        TriangleSoup sheet = cubes(0);
+        sheet.triangles.pop_back();
+        Result<BuildResult> open = build_mesh(std::move(sheet));
+        ASSERT_TRUE(open.ok());
+        const Result<ReverseReport> shells = reverse_to_step(open->mesh, path, ro);
+        ASSERT_TRUE(shells.ok());
+        EXPECT_TRUE(shells->written && !shells->solid);
+        EXPECT_EQ(shells->bodies, 2u);
+        std::filesystem::remove(path);
         Result<BuildResult> apart = build_mesh(cubes(20));  // the small cube beside the large
         ASSERT_TRUE(apart.ok());
         const Result<ReverseReport> built = reverse_to_step(apart->mesh, path, ro);

@@ -699,17 +699,17 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     }
 }
 
-// Ray-triangle tests nested_component() makes at most (about a second): a part with thousands
-// of small loose components in its box would otherwise cost components x facets.
+// Ray-triangle tests nested_component() makes at most, a bound on its work: a part with
+// thousands of small loose components in its box would otherwise cost components x facets.
 constexpr std::uint64_t kNestingWork = 300'000'000;
 
-// A closed component of `mesh` that lies inside another (a cavity), if any: "component A
-// lies inside component B", else empty. Healing turns every closed component outward, so a
-// cavity's shell would come back as a solid of its own filling it; nested bodies are not
-// built yet. Components by shared edges; a component is inside another when a ray from one of
-// its vertices crosses the other's facets an odd number of times (the majority of three
-// rays, for rays that graze an edge), tested only where its box lies in the other's.
-// `skipped`: set when the check stopped at kNestingWork (nothing found so far).
+// A closed component of `mesh` that lies inside another closed one (a cavity), if any:
+// "component A lies inside component B", else empty. Healing turns every closed component
+// outward, so a cavity's shell would come back as a solid of its own filling it; nested
+// bodies are not built yet. Components by shared edges; a component is inside another when
+// a ray from one of its vertices crosses the other's facets an odd number of times (the
+// majority of three rays, for rays that graze an edge), tested only where its box lies in
+// the other's. `skipped`: set when the check stopped at kNestingWork (nothing found so far).
 std::string nested_component(const Mesh& mesh, const MeshStats& stats, bool* skipped) {
     if (stats.components < 2) return {};
     const std::uint32_t nf = mesh.num_faces();
@@ -717,16 +717,21 @@ std::string nested_component(const Mesh& mesh, const MeshStats& stats, bool* ski
     std::vector<std::uint32_t> comp(nf, kUnset);
     std::vector<std::uint32_t> stack;
     std::uint32_t count = 0;
+    std::vector<std::uint8_t> open;  // per component: it has a boundary edge
     for (std::uint32_t f0 = 0; f0 < nf; ++f0) {
         if (comp[f0] != kUnset) continue;
         comp[f0] = count;
+        open.push_back(0);
         stack.assign(1, f0);
         while (!stack.empty()) {
             const std::uint32_t f = stack.back();
             stack.pop_back();
             for (int i = 0; i < 3; ++i) {
                 const HalfedgeId t = mesh.twin(Mesh::halfedge(FaceId(f), i));
-                if (!t.is_valid()) continue;
+                if (!t.is_valid()) {
+                    open.back() = 1;
+                    continue;
+                }
                 const std::uint32_t g = Mesh::face(t).idx();
                 if (comp[g] != kUnset) continue;
                 comp[g] = count;
@@ -765,7 +770,7 @@ std::string nested_component(const Mesh& mesh, const MeshStats& stats, bool* ski
     std::uint64_t work = 0;
     for (std::uint32_t a = 0; a < count; ++a) {
         for (std::uint32_t b = 0; b < count; ++b) {
-            if (a == b || !inside_box(box[a], box[b])) continue;
+            if (a == b || open[a] || open[b] || !inside_box(box[a], box[b])) continue;
             work += rays.size() * facets[b].size();
             if (work > kNestingWork) {
                 if (skipped) *skipped = true;
