@@ -942,15 +942,15 @@ TEST(ReverseSurfaces, ANestedPartIsRefusedNotFilled) {
 }
 
 // trimesh_featuretype meshed as the time benchmark meshes it (1e-3 of its size and 0.02 rad,
-// 81.6k facets, float32 as an STL stores them): its spline pocket wall bends 5 x as sharply at
-// one end as the part's curved edges, and that end came back as seven analytic pieces (a torus
-// of 42 facets, a cone of 37, bands of a few rows fitted to rounding) and one-facet planes whose
-// middles sag past twice the deflection estimate: 90 faces, a one-facet plane cut off from the
-// wall a fallback. A facet is now a B-spline's chord when its middle is off no more than the
-// surface bends between its corners (bspline_chord_sag()), and the wall, a surface known far
-// better than the deflection (29k facets), takes the exact pieces whose vertices it holds within
-// the tolerance (widen_freeform()): 84 faces for 79 (its split cylinder halves unified), none
-// falls back.
+// 81.6k facets, float32 as an STL stores them): its spline pocket wall bends sharply at one
+// end, whose facets' middles sag past twice the part's deflection estimate with their corners
+// on the wall, and that end came back as small regions beside it (a torus of 42 facets, a cone
+// of 37, bands of a few rows fitted to rounding, one-facet planes): 90 faces, a one-facet piece
+// of the wall cut off by them a fallback. A facet is now a B-spline's chord when its middle is off
+// no more than the surface bends between its corners (bspline_chord_sag()), and the wall, a surface
+// known far better than the deflection (29k facets), takes the exact pieces whose vertices it holds
+// within the tolerance (widen_freeform()): 84 faces for 79 (its split cylinder halves unified),
+// none falls back.
 TEST(ReverseSurfaces, ASplineWallKeepsItsSharplyBentEnd) {
     const auto path = corpus_step_dir() / "trimesh_featuretype.step";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no corpus file " << path;

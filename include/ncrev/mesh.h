@@ -202,6 +202,10 @@ Result<BuildResult> build_mesh(TriangleSoup&& soup, const HealOptions& options =
 /// Counts, area, volume, bounding box, boundary loops of a mesh.
 MeshStats compute_stats(const Mesh& mesh);
 
+/// Each facet's component: facets joined across shared edges, numbered from 0 in the order of
+/// their first facet (MeshStats::components of them).
+std::vector<std::uint32_t> face_components(const Mesh& mesh);
+
 /// Signed dihedral angle at the edge of `h`, in radians, in [-pi, pi]: the angle between the
 /// normals of its two facets, positive where the surface is convex (it bends away from the
 /// outward normals), negative where concave, 0 on a boundary edge or between coplanar facets.

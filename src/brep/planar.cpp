@@ -30,6 +30,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "detail/union_find.h"
+
 namespace ncrev::brep_detail {
 
 namespace {
@@ -49,15 +51,10 @@ double distance_to_segment(Vec3 p, Vec3 a, Vec3 b) {
     return norm(p - (a + t * ab));
 }
 
-/// Fills topo.body and topo.bodies: faces that share a segment are one body (union-find).
+/// Fills topo.body and topo.bodies: faces that share a segment are one body.
 void number_bodies(PlanarTopology& topo) {
-    const std::size_t nf = topo.faces.size();
-    std::vector<std::uint32_t> parent(nf);
-    for (std::uint32_t f = 0; f < nf; ++f) parent[f] = f;
-    const auto root = [&](std::uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    };
+    const auto nf = static_cast<std::uint32_t>(topo.faces.size());
+    detail::MinUnionFind bodies(nf);
     std::vector<std::uint32_t> face_of_segment(topo.segments.size(), kNone);
     for (std::uint32_t f = 0; f < nf; ++f) {
         for (const PlanarTopology::Loop& loop : topo.faces[f].loops) {
@@ -66,8 +63,7 @@ void number_bodies(PlanarTopology& topo) {
                 if (other == kNone) {
                     other = f;
                 } else {
-                    const std::uint32_t a = root(other), b = root(f);
-                    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+                    bodies.unite(other, f);
                 }
             }
         }
@@ -76,7 +72,7 @@ void number_bodies(PlanarTopology& topo) {
     std::vector<std::uint32_t> number(nf, kNone);
     topo.bodies = 0;
     for (std::uint32_t f = 0; f < nf; ++f) {
-        std::uint32_t& n = number[root(f)];
+        std::uint32_t& n = number[bodies.find(f)];
         if (n == kNone) n = topo.bodies++;
         topo.body[f] = n;
     }

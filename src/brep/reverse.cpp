@@ -713,60 +713,26 @@ constexpr std::uint64_t kNestingWork = 300'000'000;
 std::string nested_component(const Mesh& mesh, const MeshStats& stats, bool* skipped) {
     if (stats.components < 2) return {};
     const std::uint32_t nf = mesh.num_faces();
-    constexpr std::uint32_t kUnset = 0xFFFFFFFFu;
-    std::vector<std::uint32_t> comp(nf, kUnset);
-    std::vector<std::uint32_t> stack;
-    std::uint32_t count = 0;
-    std::vector<std::uint8_t> open;  // per component: it has a boundary edge
-    for (std::uint32_t f0 = 0; f0 < nf; ++f0) {
-        if (comp[f0] != kUnset) continue;
-        comp[f0] = count;
-        open.push_back(0);
-        stack.assign(1, f0);
-        while (!stack.empty()) {
-            const std::uint32_t f = stack.back();
-            stack.pop_back();
-            for (int i = 0; i < 3; ++i) {
-                const HalfedgeId t = mesh.twin(Mesh::halfedge(FaceId(f), i));
-                if (!t.is_valid()) {
-                    open.back() = 1;
-                    continue;
-                }
-                const std::uint32_t g = Mesh::face(t).idx();
-                if (comp[g] != kUnset) continue;
-                comp[g] = count;
-                stack.push_back(g);
-            }
-        }
-        ++count;
-    }
-    if (count < 2) return {};
-    constexpr double kBig = std::numeric_limits<double>::infinity();
-    struct Box {
-        Vec3 lo{kBig, kBig, kBig}, hi{-kBig, -kBig, -kBig};
-        Vec3 seed;
-        bool seeded = false;
-    };
-    std::vector<Box> box(count);
+    const std::vector<std::uint32_t> comp = face_components(mesh);
+    const auto count = static_cast<std::uint32_t>(stats.components);
+    std::vector<std::vector<std::uint32_t>> facets(count);
+    std::vector<std::uint8_t> open(count, 0);  // a boundary edge
+    std::vector<Box3> box(count);
     for (std::uint32_t f = 0; f < nf; ++f) {
-        Box& b = box[comp[f]];
+        facets[comp[f]].push_back(f);
         for (int i = 0; i < 3; ++i) {
-            const Vec3 p = mesh.position(mesh.vertex(FaceId(f), i));
-            b.lo = {std::min(b.lo.x, p.x), std::min(b.lo.y, p.y), std::min(b.lo.z, p.z)};
-            b.hi = {std::max(b.hi.x, p.x), std::max(b.hi.y, p.y), std::max(b.hi.z, p.z)};
-            if (!b.seeded) b.seed = p, b.seeded = true;
+            box[comp[f]].add(mesh.position(mesh.vertex(FaceId(f), i)));
+            open[comp[f]] |= !mesh.twin(Mesh::halfedge(FaceId(f), i)).is_valid();
         }
     }
-    const auto inside_box = [](const Box& a, const Box& b) {
-        return a.lo.x >= b.lo.x && a.lo.y >= b.lo.y && a.lo.z >= b.lo.z && a.hi.x <= b.hi.x &&
-               a.hi.y <= b.hi.y && a.hi.z <= b.hi.z;
+    const auto inside_box = [](const Box3& a, const Box3& b) {
+        return a.min.x >= b.min.x && a.min.y >= b.min.y && a.min.z >= b.min.z &&
+               a.max.x <= b.max.x && a.max.y <= b.max.y && a.max.z <= b.max.z;
     };
     // Directions no mesh of a machined part lines up with.
     const std::array<Vec3, 3> rays{normalized(Vec3{0.5773, 0.4082, 0.7071}),
                                    normalized(Vec3{-0.3162, 0.8944, 0.3169}),
                                    normalized(Vec3{0.6325, -0.2236, -0.7416})};
-    std::vector<std::vector<std::uint32_t>> facets(count);
-    for (std::uint32_t f = 0; f < nf; ++f) facets[comp[f]].push_back(f);
     std::uint64_t work = 0;
     for (std::uint32_t a = 0; a < count; ++a) {
         for (std::uint32_t b = 0; b < count; ++b) {
@@ -776,10 +742,11 @@ std::string nested_component(const Mesh& mesh, const MeshStats& stats, bool* ski
                 if (skipped) *skipped = true;
                 return {};
             }
+            // From a vertex of a (a component lies wholly inside another or outside it).
+            const Vec3 o = mesh.position(mesh.vertex(FaceId(facets[a].front()), 0));
             int odd = 0;
             for (const Vec3& d : rays) {
                 std::uint64_t hits = 0;
-                const Vec3 o = box[a].seed;
                 for (const std::uint32_t f : facets[b]) {
                     const Vec3 p0 = mesh.position(mesh.vertex(FaceId(f), 0));
                     const Vec3 e1 = mesh.position(mesh.vertex(FaceId(f), 1)) - p0;

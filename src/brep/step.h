@@ -52,6 +52,6 @@ inline constexpr std::size_t kReadBackPlaces = 64;
 
 /// Reads `path` back with OpenCASCADE's STEP reader and checks it: `solids` solids (one per
 /// body written), each valid.
-ReadBack step_read_back(const std::filesystem::path& path, int solids = 1);
+ReadBack step_read_back(const std::filesystem::path& path, int solids);
 
 }  // namespace ncrev::brep_detail

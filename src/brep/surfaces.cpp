@@ -82,7 +82,6 @@
 #include <cstdint>
 #include <map>
 #include <numbers>
-#include <numeric>
 #include <optional>
 #include <tuple>
 #include <unordered_map>
@@ -90,6 +89,7 @@
 
 #include "brep/check.h"
 #include "brep/deviation.h"
+#include "detail/union_find.h"
 #include "ncrev/segment.h"
 
 namespace ncrev::brep_detail {
@@ -1910,36 +1910,21 @@ TopoDS_Shape solids_of(const TopoDS_Shell& shell) {
     BRep_Builder B;
     std::vector<TopoDS_Shape> members;
     for (TopoDS_Iterator it(shell); it.More(); it.Next()) members.push_back(it.Value());
-    TopTools_IndexedMapOfShape index;  // faces, orientation aside
+    TopTools_IndexedMapOfShape index;  // faces, orientation aside (1-based)
     for (const TopoDS_Shape& f : members) index.Add(f);
-    std::vector<int> parent(static_cast<std::size_t>(index.Extent()) + 1);
-    std::iota(parent.begin(), parent.end(), 0);
-    const auto root = [&](int x) {
-        while (parent[static_cast<std::size_t>(x)] != x) {
-            x = parent[static_cast<std::size_t>(x)] =
-                parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
-        }
-        return x;
-    };
+    detail::MinUnionFind pieces_of(static_cast<std::size_t>(index.Extent()) + 1);
     TopTools_IndexedDataMapOfShapeListOfShape edge_faces;
     TopExp::MapShapesAndUniqueAncestors(shell, TopAbs_EDGE, TopAbs_FACE, edge_faces);
     for (int i = 1; i <= edge_faces.Extent(); ++i) {
-        int first = 0;
-        for (const TopoDS_Shape& f : edge_faces.FindFromIndex(i)) {
-            const int k = index.FindIndex(f);
-            if (k == 0) continue;
-            if (first == 0) {
-                first = k;
-                continue;
-            }
-            const int a = root(first), b = root(k);
-            if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
-        }
+        const auto first =
+            static_cast<std::uint32_t>(index.FindIndex(edge_faces.FindFromIndex(i).First()));
+        for (const TopoDS_Shape& f : edge_faces.FindFromIndex(i))
+            pieces_of.unite(first, static_cast<std::uint32_t>(index.FindIndex(f)));
     }
-    std::map<int, TopoDS_Shell> pieces;  // by root: the smallest index of a piece's faces
+    std::map<std::uint32_t, TopoDS_Shell> pieces;  // by root: the smallest index of its faces
     for (const TopoDS_Shape& f : members) {
-        const int r = root(index.FindIndex(f));
-        auto [it, fresh] = pieces.try_emplace(r);
+        auto [it, fresh] =
+            pieces.try_emplace(pieces_of.find(static_cast<std::uint32_t>(index.FindIndex(f))));
         if (fresh) B.MakeShell(it->second);
         B.Add(it->second, f);
     }

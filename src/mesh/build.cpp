@@ -18,6 +18,7 @@
 
 #include "detail/exact_weld.h"
 #include "detail/huge_pages.h"
+#include "detail/union_find.h"
 #include "ncrev/mesh.h"
 
 namespace ncrev {
@@ -79,29 +80,6 @@ std::uint32_t weld_exact(std::span<const Vec3> pts, std::vector<std::uint32_t>& 
     return static_cast<std::uint32_t>(welder.size());
 }
 
-/// Union-find whose root is always the smallest index of its set: the result does not depend
-/// on the order of the unions.
-struct MinUnionFind {
-    std::vector<std::uint32_t> parent;
-    explicit MinUnionFind(std::size_t n) : parent(n) {
-        std::iota(parent.begin(), parent.end(), 0u);
-    }
-    std::uint32_t find(std::uint32_t a) {
-        while (parent[a] != a) {
-            parent[a] = parent[parent[a]];
-            a = parent[a];
-        }
-        return a;
-    }
-    void unite(std::uint32_t a, std::uint32_t b) {
-        a = find(a);
-        b = find(b);
-        if (a == b) return;
-        if (a < b) std::swap(a, b);
-        parent[a] = b;
-    }
-};
-
 /// Tolerance weld among `cand` (ascending vertex ids): merges every pair closer than `tol`,
 /// transitively. Sets map[v] to the smallest vertex of v's group (identity elsewhere) and
 /// returns the number of vertices merged away.
@@ -151,7 +129,7 @@ std::uint64_t weld_tolerance(std::span<const Vec3> pos, std::span<const std::uin
         next[i] = head[s];
         head[s] = static_cast<std::uint32_t>(i);
     }
-    MinUnionFind uf(n);
+    detail::MinUnionFind uf(n);
     const double tol2 = tol * tol;
     for (std::size_t i = 0; i < n; ++i) {
         const Vec3 p = pos[cand[i]];

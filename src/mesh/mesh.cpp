@@ -77,6 +77,33 @@ std::string Mesh::validate() const {
     return {};
 }
 
+std::vector<std::uint32_t> face_components(const Mesh& mesh) {
+    const std::size_t nf = mesh.num_faces();
+    std::vector<std::uint32_t> comp;
+    detail::assign_huge(comp, nf, std::uint32_t{HalfedgeId::kInvalid});
+    std::vector<std::uint32_t> stack;
+    std::uint32_t count = 0;
+    for (std::size_t seed = 0; seed < nf; ++seed) {
+        if (comp[seed] != HalfedgeId::kInvalid) continue;
+        const std::uint32_t id = count++;
+        comp[seed] = id;
+        stack.push_back(static_cast<std::uint32_t>(seed));
+        while (!stack.empty()) {
+            const std::uint32_t f = stack.back();
+            stack.pop_back();
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t t = mesh.twins()[3 * f + k];
+                if (t == HalfedgeId::kInvalid) continue;
+                if (comp[t / 3] == HalfedgeId::kInvalid) {
+                    comp[t / 3] = id;
+                    stack.push_back(t / 3);
+                }
+            }
+        }
+    }
+    return comp;
+}
+
 MeshStats compute_stats(const Mesh& mesh) {
     MeshStats s;
     const std::size_t nh = mesh.num_halfedges(), nf = mesh.num_faces();
@@ -107,27 +134,8 @@ MeshStats compute_stats(const Mesh& mesh) {
     s.volume = vol6 / 6.0;
 
     // Components: faces joined across twins.
-    std::vector<std::uint32_t> comp;
-    detail::assign_huge(comp, nf, std::uint32_t{HalfedgeId::kInvalid});
-    std::vector<std::uint32_t> stack;
-    for (std::size_t seed = 0; seed < nf; ++seed) {
-        if (comp[seed] != HalfedgeId::kInvalid) continue;
-        const auto id = static_cast<std::uint32_t>(s.components++);
-        comp[seed] = id;
-        stack.push_back(static_cast<std::uint32_t>(seed));
-        while (!stack.empty()) {
-            const std::uint32_t f = stack.back();
-            stack.pop_back();
-            for (int k = 0; k < 3; ++k) {
-                const std::uint32_t t = mesh.twins()[3 * f + k];
-                if (t == HalfedgeId::kInvalid) continue;
-                if (comp[t / 3] == HalfedgeId::kInvalid) {
-                    comp[t / 3] = id;
-                    stack.push_back(t / 3);
-                }
-            }
-        }
-    }
+    const std::vector<std::uint32_t> comp = face_components(mesh);
+    if (!comp.empty()) s.components = *std::max_element(comp.begin(), comp.end()) + 1u;
 
     // Boundary loops: from a boundary half-edge, the next one starts at its target and is
     // that vertex's outgoing half-edge (the one without twin).

@@ -2555,9 +2555,9 @@ std::vector<std::uint32_t> widen_freeform(Context& c, std::vector<Draft>& drafts
             // B-spline's chords may sag: a net stretched over pieces at its border bulged
             // between their vertices (the link rods' solid 2.4 deflections from the mesh).
             // A large region's surface is its own, not stretched over the piece: its middles may
-            // sag as far as that surface bends between their corners (bspline_chord_sag(); the
-            // wall's end bends 5 x as sharply as the part's curved edges, its pieces' middles
-            // 0.03-0.09 mm off it, the deflection 0.015 mm).
+            // sag as far as that surface bends between their corners (bspline_chord_sag(); at
+            // the wall's end its pieces' middles are 0.03-0.09 mm off it, the deflection
+            // 0.015 mm).
             if (std::any_of(pf.begin(), pf.end(), [&](std::uint32_t f) {
                     const double d = distance(r.surface, c.fd.centroid[f]);
                     return d > c.sag && !(large && d <= bspline_chord_sag(c, r.surface, f));
