@@ -15,6 +15,11 @@ struct MinUnionFind {
     explicit MinUnionFind(std::size_t n) : parent(n) {
         std::iota(parent.begin(), parent.end(), 0u);
     }
+    /// A new member in a set of its own; its index.
+    std::uint32_t add() {
+        parent.push_back(static_cast<std::uint32_t>(parent.size()));
+        return parent.back();
+    }
     std::uint32_t find(std::uint32_t a) {
         while (parent[a] != a) {
             parent[a] = parent[parent[a]];

@@ -30,6 +30,7 @@
 #include <optional>
 #include <unordered_map>
 
+#include "detail/union_find.h"
 #include "sample/sample_internal.h"
 
 namespace ncrev::sample_detail {
@@ -37,35 +38,6 @@ namespace ncrev::sample_detail {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-/// Union-find whose root is always the smallest member, so representatives do not depend
-/// on the order of the unions.
-class UnionFind {
-   public:
-    explicit UnionFind(std::size_t n) : parent_(n) {
-        for (std::size_t i = 0; i < n; ++i) parent_[i] = static_cast<std::uint32_t>(i);
-    }
-    std::uint32_t add() {
-        parent_.push_back(static_cast<std::uint32_t>(parent_.size()));
-        return parent_.back();
-    }
-    std::uint32_t find(std::uint32_t a) {
-        while (parent_[a] != a) {
-            parent_[a] = parent_[parent_[a]];
-            a = parent_[a];
-        }
-        return a;
-    }
-    void unite(std::uint32_t a, std::uint32_t b) {
-        a = find(a);
-        b = find(b);
-        if (a < b) parent_[b] = a;
-        if (b < a) parent_[a] = b;
-    }
-
-   private:
-    std::vector<std::uint32_t> parent_;
-};
 
 Vec3 to_vec(const gp_XYZ& p) { return {p.X(), p.Y(), p.Z()}; }
 // "+ 0.0" turns -0.0 into 0.0: the same value, printed without a stray sign.
@@ -308,7 +280,7 @@ void tessellate_solid(const TopoDS_Shape& solid, SamplePart& part, std::vector<J
     const std::size_t num_raw = raw.size();
 
     // Topological weld: node k of an edge's polygon is the same point on every face.
-    UnionFind uf(num_raw);
+    detail::MinUnionFind uf(num_raw);
     struct Slots {
         std::uint32_t first = 0;
         int count = 0;
