@@ -84,6 +84,40 @@ TEST(CliInfo, PrintsOneJsonDocumentWithTheDocumentedKeys) {
     std::filesystem::remove(path);
 }
 
+// A cube of side 3 with a cubic cavity of side 1, the cavity's shell facing out of it as
+// some writers leave it: healing faces it into the cavity, the volume is the material's, and
+// reverse builds one solid with a void.
+TEST(CliInfo, ACavityIsCountedAndItsVolumeIsNotMaterial) {
+    auto inner = test::cube({1, 1, 1}, 1.0);
+    const auto m = test::merge(test::cube({0, 0, 0}, 3.0), inner);
+    const auto path = write_temp("ncrev_cli_cavity.stl", encode_stl_binary(m.points, m.triangles));
+    const CliRun r = run("info --json " + path.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["healing"]["cavities"], 1);
+    EXPECT_EQ(j["healing"]["cavities_turned_inward"], 1);
+    EXPECT_EQ(j["healing"]["nesting_checked"], true);
+    EXPECT_DOUBLE_EQ(j["mesh"]["volume"].template get<double>(), 26.0);
+    const CliRun text = run("info " + path.string());
+    EXPECT_NE(text.out.find("cavities: 1"), std::string::npos) << text.out;
+    EXPECT_NE(text.err.find("1 cavity shells turned inward"), std::string::npos) << text.err;
+    const auto step = test::scratch_dir() / "ncrev_cli_cavity.step";
+    for (const char* method : {"auto", "planar"}) {
+        const CliRun rev = run("reverse " + path.string() + " -o " + step.string() + " --method " +
+                               method + " --json");
+        ASSERT_EQ(rev.code, 0) << method << rev.err;
+        const auto jr = nlohmann::json::parse(rev.out);
+        EXPECT_EQ(jr["reverse"]["bodies"], 1) << method;
+        EXPECT_EQ(jr["reverse"]["voids"], 1) << method;
+        EXPECT_EQ(jr["reverse"]["faces"], 12) << method;
+        const CliRun said =
+            run("reverse " + path.string() + " -o " + step.string() + " --method " + method);
+        EXPECT_NE(said.err.find("closed solid with 1 cavity"), std::string::npos) << said.err;
+    }
+    std::filesystem::remove(step);
+    std::filesystem::remove(path);
+}
+
 TEST(CliInfo, BadInputExitsTwoWithFileAndPlaceAndNoStdout) {
     const auto path =
         write_temp("ncrev_cli_bad.stl", test::bytes_of("solid x\nfacet normal 0 0 1\nouter lop\n"));

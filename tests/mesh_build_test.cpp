@@ -110,6 +110,60 @@ TEST(MeshBuild, InsideOutWithFewFlippedFacetsCountsBoth) {
     EXPECT_DOUBLE_EQ(compute_stats(b.mesh).volume, 1.0);
 }
 
+// Balls of radius 3, 2 and 1 round one center: a part, a cavity in it, an island in the
+// cavity. The cavity's shell faces into the cavity, whichever way it came, so the signed volume
+// is the material's; the balls side by side are three parts.
+TEST(MeshBuild, TurnsACavitysShellIntoTheCavity) {
+    const auto balls = [](double shift, std::array<bool, 3> inward) {
+        test::Indexed all;
+        for (int k = 0; k < 3; ++k) {
+            test::Indexed b = test::icosphere(3.0 - k, 3, {k * shift, 0, 0});
+            if (inward[k]) {
+                for (auto& t : b.triangles) std::swap(t[1], t[2]);
+            }
+            const auto base = static_cast<std::uint32_t>(all.points.size());
+            all.points.insert(all.points.end(), b.points.begin(), b.points.end());
+            for (const auto& t : b.triangles)
+                all.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+        }
+        return test::to_bucket(all);
+    };
+    const auto volume = [](double r) {
+        const test::Indexed b = test::icosphere(r, 3);
+        double v6 = 0;
+        for (const auto& t : b.triangles)
+            v6 += dot(b.points[t[0]], cross(b.points[t[1]], b.points[t[2]]));
+        return v6 / 6;
+    };
+    const double nested = volume(3) - volume(2) + volume(1);
+    for (const std::array<bool, 3> inward :
+         {std::array{false, false, false}, std::array{false, true, false},
+          std::array{true, false, true}, std::array{true, true, true}}) {
+        const BuildResult b = build_ok(balls(0, inward));
+        EXPECT_EQ(b.heal.cavities, 1u);
+        EXPECT_EQ(b.heal.cavities_turned_inward, inward[1] ? 0u : 1u);
+        EXPECT_EQ(b.heal.components_turned_outward, (inward[0] ? 1u : 0u) + (inward[2] ? 1u : 0u));
+        EXPECT_FALSE(b.heal.nesting_unchecked);
+        const MeshStats s = compute_stats(b.mesh);
+        EXPECT_EQ(s.components, 3u);
+        EXPECT_NEAR(s.volume, nested, 1e-6 * nested);
+        const ComponentNesting n = component_nesting(b.mesh);
+        EXPECT_TRUE(n.complete);
+        // Components in the order of their first facet: the balls' order.
+        EXPECT_EQ(n.depth, (std::vector<std::uint32_t>{0, 1, 2}));
+        EXPECT_EQ(n.parent, (std::vector<std::uint32_t>{ComponentNesting::kNone, 0, 1}));
+    }
+    const BuildResult apart = build_ok(balls(7, {false, true, false}));
+    EXPECT_EQ(apart.heal.cavities, 0u);
+    EXPECT_EQ(apart.heal.components_turned_outward, 1u);
+    EXPECT_NEAR(compute_stats(apart.mesh).volume, volume(3) + volume(2) + volume(1), 1e-6 * nested);
+    EXPECT_EQ(component_nesting(apart.mesh).depth, (std::vector<std::uint32_t>{0, 0, 0}));
+    // With orientation off, nothing is turned.
+    HealOptions keep;
+    keep.orient = false;
+    EXPECT_EQ(build_ok(balls(0, {false, false, false}), keep).heal.cavities, 0u);
+}
+
 TEST(MeshBuild, RemovesDuplicateFacetsInAnyOrderOrOrientation) {
     auto m = test::cube();
     m.triangles.push_back(m.triangles[0]);

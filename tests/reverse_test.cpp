@@ -40,6 +40,7 @@
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <span>
@@ -872,72 +873,164 @@ TEST(ReverseSurfaces, PartsSideBySideAreSolidsOfTheirOwn) {
     }
 }
 
-// A closed part inside another (a cavity's shell, or a part inside a part) is not built yet:
-// healing turns every closed component outward, so a cavity would come back as a solid of its
-// own filling it. Refused with the reason, nothing written; side by side the same cubes build.
-TEST(ReverseSurfaces, ANestedPartIsRefusedNotFilled) {
-    const auto cubes = [](double inner_offset) {
-        TriangleSoup soup;
-        const auto cube = [&](Vec3 lo, Vec3 hi, bool inward) {
-            const auto base = static_cast<std::uint32_t>(soup.points.size());
-            for (int k = 0; k < 8; ++k) {
-                soup.points.push_back(
-                    {k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z});
+// A closed shell inside a part is a cavity: healing faces it into the cavity, whichever way
+// the file had it, and every method builds it as a void of the part's solid (written as a
+// BREP_WITH_VOIDS). Until the forty-fourth session healing turned it outward, so a cavity would
+// have come back as a solid filling it, and such meshes were refused. A part inside the cavity
+// is a solid of its own; side by side the same shells are two solids; an open sheet inside
+// has no inside and stays a shell.
+TEST(ReverseSurfaces, ACavityIsAVoidOfItsSolid) {
+    TriangleSoup soup;
+    const auto cube = [&](Vec3 lo, Vec3 hi, bool inward) {
+        const auto base = static_cast<std::uint32_t>(soup.points.size());
+        for (int k = 0; k < 8; ++k)
+            soup.points.push_back({k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z});
+        // Outward: counter-clockwise seen from outside.
+        const std::array<std::array<std::uint32_t, 4>, 6> quads{
+            {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}};
+        for (const auto& q : quads) {
+            for (const auto& t : {std::array<std::uint32_t, 3>{q[0], q[1], q[2]},
+                                  std::array<std::uint32_t, 3>{q[0], q[2], q[3]}}) {
+                soup.triangles.push_back(inward
+                                             ? std::array{base + t[0], base + t[2], base + t[1]}
+                                             : std::array{base + t[0], base + t[1], base + t[2]});
             }
-            // Outward: counter-clockwise seen from outside.
-            const std::array<std::array<std::uint32_t, 4>, 6> quads{{{0, 2, 3, 1},
-                                                                     {4, 5, 7, 6},
-                                                                     {0, 1, 5, 4},
-                                                                     {2, 6, 7, 3},
-                                                                     {0, 4, 6, 2},
-                                                                     {1, 3, 7, 5}}};
-            for (const auto& q : quads) {
-                for (const auto& t : {std::array<std::uint32_t, 3>{q[0], q[1], q[2]},
-                                      std::array<std::uint32_t, 3>{q[0], q[2], q[3]}}) {
-                    if (inward)
-                        soup.triangles.push_back({base + t[0], base + t[2], base + t[1]});
-                    else
-                        soup.triangles.push_back({base + t[0], base + t[1], base + t[2]});
-                }
-            }
-        };
-        cube({0, 0, 0}, {10, 10, 10}, false);
-        cube({3 + inner_offset, 3, 3}, {7 + inner_offset, 7, 7}, inner_offset == 0);
-        return soup;
+        }
     };
-    for (const ReverseMethod method : {ReverseMethod::kAuto, ReverseMethod::kPlanar}) {
-        const auto path = out_dir() / "nested_cubes.step";
-        std::filesystem::remove(path);
-        Result<BuildResult> nested = build_mesh(cubes(0));
-        ASSERT_TRUE(nested.ok());
+    // A ball of radius r at c, in rings of latitude: outward unless `inward`.
+    const auto ball = [&](Vec3 c, double r, bool inward) {
+        constexpr int kRings = 24, kSectors = 48;
+        const auto base = static_cast<std::uint32_t>(soup.points.size());
+        soup.points.push_back(c + Vec3{0, 0, r});
+        for (int i = 1; i < kRings; ++i) {
+            const double theta = std::numbers::pi * i / kRings;
+            for (int j = 0; j < kSectors; ++j) {
+                const double phi = 2 * std::numbers::pi * j / kSectors;
+                soup.points.push_back(c + r * Vec3{std::sin(theta) * std::cos(phi),
+                                                   std::sin(theta) * std::sin(phi),
+                                                   std::cos(theta)});
+            }
+        }
+        soup.points.push_back(c - Vec3{0, 0, r});
+        const auto at = [&](int i, int j) -> std::uint32_t {  // ring i in 1..kRings-1
+            return base + 1 + static_cast<std::uint32_t>((i - 1) * kSectors + (j % kSectors));
+        };
+        const std::uint32_t bottom = base + 1 + (kRings - 1) * kSectors;
+        const auto add = [&](std::uint32_t a, std::uint32_t b, std::uint32_t d) {
+            soup.triangles.push_back(inward ? std::array{a, d, b} : std::array{a, b, d});
+        };
+        for (int j = 0; j < kSectors; ++j) {
+            add(base, at(1, j), at(1, j + 1));
+            add(bottom, at(kRings - 1, j + 1), at(kRings - 1, j));
+            for (int i = 1; i + 1 < kRings; ++i) {
+                add(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+                add(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+            }
+        }
+    };
+    const auto reverse = [&](ReverseMethod method, const std::string& tag) {
+        Result<BuildResult> built = build_mesh(soup);
+        EXPECT_TRUE(built.ok()) << tag;
+        const auto path = out_dir() / (tag + ".step");
         ReverseOptions ro;
         ro.method = method;
-        const Result<ReverseReport> refused = reverse_to_step(nested->mesh, path, ro);
-        ASSERT_TRUE(refused.ok());
-        EXPECT_FALSE(refused->written);
-        EXPECT_FALSE(std::filesystem::exists(path));
-        ASSERT_FALSE(refused->warnings.empty());
-        EXPECT_NE(refused->warnings.back().find("inside"), std::string::npos)
-            << refused->warnings.back();
-        // An open sheet inside is no cavity (no inside to count): built, as open shells.
-        TriangleSoup sheet = cubes(0);
-        sheet.triangles.pop_back();
-        Result<BuildResult> open = build_mesh(std::move(sheet));
-        ASSERT_TRUE(open.ok());
-        const Result<ReverseReport> shells = reverse_to_step(open->mesh, path, ro);
-        ASSERT_TRUE(shells.ok());
-        EXPECT_TRUE(shells->written && !shells->solid);
-        EXPECT_EQ(shells->bodies, 2u);
+        Result<ReverseReport> rev = reverse_to_step(built->mesh, path, ro);
+        EXPECT_TRUE(rev.ok()) << tag;
+        std::pair<ReverseReport, test::ReadBack> out{rev.ok() ? *rev : ReverseReport{}, {}};
+        if (rev.ok() && rev->written) out.second = test::read_step(path);
         std::filesystem::remove(path);
-        Result<BuildResult> apart = build_mesh(cubes(20));  // the small cube beside the large
-        ASSERT_TRUE(apart.ok());
-        const Result<ReverseReport> built = reverse_to_step(apart->mesh, path, ro);
-        ASSERT_TRUE(built.ok());
-        EXPECT_TRUE(built->written && built->valid);
-        EXPECT_EQ(built->bodies, 2u);
-        EXPECT_EQ(built->faces, 12u);
-        EXPECT_NEAR(built->solid_volume, 1000 + 64, 1e-6);
-        std::filesystem::remove(path);
+        return std::pair{std::move(out), built.ok() ? built->heal : HealReport{}};
+    };
+    const std::array methods{ReverseMethod::kAuto, ReverseMethod::kPlanar, ReverseMethod::kFacets};
+    const auto name = [](ReverseMethod m) {
+        return m == ReverseMethod::kAuto     ? "auto"
+               : m == ReverseMethod::kPlanar ? "planar"
+                                             : "facets";
+    };
+    // A cubic cavity, its shell given facing out of it and facing into it.
+    for (const bool given_inward : {false, true}) {
+        soup = {};
+        cube({0, 0, 0}, {10, 10, 10}, false);
+        cube({3, 3, 3}, {7, 7, 7}, given_inward);
+        for (const ReverseMethod method : methods) {
+            const std::string tag = std::string("cavity_") + name(method) +
+                                    (given_inward ? "_given_inward" : "_given_outward");
+            const auto [o, heal] = reverse(method, tag);
+            EXPECT_EQ(heal.cavities, 1u) << tag;
+            EXPECT_EQ(heal.cavities_turned_inward, given_inward ? 0u : 1u) << tag;
+            EXPECT_EQ(heal.components_turned_outward, 0u) << tag;
+            EXPECT_TRUE(o.first.written && o.first.solid && o.first.valid) << tag;
+            EXPECT_EQ(o.first.bodies, 1u) << tag;
+            EXPECT_EQ(o.first.voids, 1u) << tag;
+            EXPECT_NEAR(o.first.mesh_volume, 1000 - 64, 1e-9) << tag;
+            EXPECT_NEAR(o.first.solid_volume, 1000 - 64, 1e-6) << tag;
+            EXPECT_TRUE(o.second.valid) << tag;
+            EXPECT_EQ(o.second.solids, 1u) << tag;
+            EXPECT_EQ(o.second.faces, o.first.faces) << tag;
+            EXPECT_NEAR(o.second.volume, 1000 - 64, 1e-6) << tag;
+        }
+    }
+    // An island in the cavity: two solids, one of them with a void.
+    soup = {};
+    cube({0, 0, 0}, {10, 10, 10}, false);
+    cube({2, 2, 2}, {8, 8, 8}, false);
+    cube({4, 4, 4}, {6, 6, 6}, true);
+    for (const ReverseMethod method : methods) {
+        const std::string tag = std::string("island_") + name(method);
+        const auto [o, heal] = reverse(method, tag);
+        EXPECT_EQ(heal.cavities, 1u) << tag;
+        EXPECT_EQ(heal.components_turned_outward, 1u) << tag;  // the island
+        EXPECT_TRUE(o.first.written && o.first.valid) << tag;
+        EXPECT_EQ(o.first.bodies, 2u) << tag;
+        EXPECT_EQ(o.first.voids, 1u) << tag;
+        EXPECT_TRUE(o.second.valid) << tag;
+        EXPECT_EQ(o.second.solids, 2u) << tag;
+        EXPECT_NEAR(o.second.volume, 1000 - 216 + 8, 1e-6) << tag;
+    }
+    // A spherical cavity: one sphere face, concave.
+    soup = {};
+    cube({0, 0, 0}, {10, 10, 10}, false);
+    ball({5, 5, 5}, 3, false);
+    {
+        const auto [o, heal] = reverse(ReverseMethod::kAuto, "ball_cavity");
+        EXPECT_EQ(heal.cavities, 1u);
+        EXPECT_TRUE(o.first.written && o.first.valid);
+        EXPECT_TRUE(o.first.fallbacks.empty());
+        EXPECT_EQ(o.first.voids, 1u);
+        EXPECT_EQ(o.first.faces_by_kind.at("sphere"), 1u);
+        EXPECT_EQ(o.first.faces, 7u);
+        EXPECT_TRUE(o.second.valid);
+        EXPECT_EQ(o.second.solids, 1u);
+        // The exact ball, within the chords' sag over its volume (the mesh's volume is less).
+        const double exact = 1000 - 4.0 / 3.0 * std::numbers::pi * 27;
+        EXPECT_NEAR(o.second.volume, exact, 1e-3 * exact);
+        EXPECT_LT(o.second.volume, o.first.mesh_volume);
+    }
+    // Side by side: two solids, no void; an open sheet inside: shells.
+    soup = {};
+    cube({0, 0, 0}, {10, 10, 10}, false);
+    cube({23, 3, 3}, {27, 7, 7}, true);
+    for (const ReverseMethod method : methods) {
+        const std::string tag = std::string("apart_") + name(method);
+        const auto [o, heal] = reverse(method, tag);
+        EXPECT_EQ(heal.cavities, 0u) << tag;
+        EXPECT_EQ(heal.components_turned_outward, 1u) << tag;
+        EXPECT_TRUE(o.first.written && o.first.valid) << tag;
+        EXPECT_EQ(o.first.bodies, 2u) << tag;
+        EXPECT_EQ(o.first.voids, 0u) << tag;
+        EXPECT_NEAR(o.second.volume, 1000 + 64, 1e-6) << tag;
+    }
+    soup = {};
+    cube({0, 0, 0}, {10, 10, 10}, false);
+    cube({3, 3, 3}, {7, 7, 7}, true);
+    soup.triangles.pop_back();
+    for (const ReverseMethod method : methods) {
+        const std::string tag = std::string("sheet_") + name(method);
+        const auto [o, heal] = reverse(method, tag);
+        EXPECT_EQ(heal.cavities, 0u) << tag;
+        EXPECT_TRUE(o.first.written && !o.first.solid) << tag;
+        EXPECT_EQ(o.first.bodies, 2u) << tag;
+        EXPECT_EQ(o.first.voids, 0u) << tag;
     }
 }
 

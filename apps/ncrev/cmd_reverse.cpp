@@ -191,11 +191,15 @@ void add_reverse(CLI::App& app, Context& ctx) {
             for (const auto& [kind, n] : rev->faces_by_kind) {
                 kinds += (kinds.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
             }
-            const std::string bodies =
+            std::string bodies =
                 rev->bodies > 1
                     ? std::to_string(rev->bodies) + (rev->solid ? " closed solids" : " open shells")
                 : rev->solid ? "closed solid"
                              : "open shell";
+            if (rev->voids) {
+                bodies += " with " + std::to_string(rev->voids) +
+                          (rev->voids > 1 ? " cavities" : " cavity");
+            }
             std::fprintf(stderr, "%s: %llu faces (%s), %llu edges, %llu vertices, %s, %llu bytes\n",
                          o->output.c_str(), static_cast<unsigned long long>(rev->faces),
                          kinds.c_str(), static_cast<unsigned long long>(rev->edges),

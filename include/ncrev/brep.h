@@ -104,6 +104,9 @@ struct ReverseReport {
     /// Bodies: connected shells, one per component of the mesh (several parts side by side
     /// give several), each a solid when closed; written as that many solids (or shells).
     std::uint64_t bodies = 0;
+    /// Cavities: closed shells inside a body (healing faces them into the cavity), each a void
+    /// of the body's solid (written as a BREP_WITH_VOIDS).
+    std::uint64_t voids = 0;
     bool valid = false;         ///< the structural check (and BRepCheck_Analyzer) found no defect
     bool occt_checked = false;  ///< BRepCheck_Analyzer ran too (B-reps of up to 5000 faces)
     double solid_volume = 0, solid_area = 0;  ///< of the B-rep's faces

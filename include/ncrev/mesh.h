@@ -139,7 +139,7 @@ struct HealOptions {
     /// Tolerance weld distance in model units. Negative: derived from the model (see
     /// HealReport::tolerance_rule). Zero: exact weld only.
     double weld_tolerance = -1.0;
-    /// Orient facets consistently and turn closed components outward.
+    /// Orient facets consistently, turn closed components outward and cavities' shells inward.
     bool orient = true;
 };
 
@@ -159,8 +159,15 @@ struct HealReport {
     std::uint64_t duplicate_facets_removed = 0;   ///< same three vertices as an earlier facet
     std::uint64_t flipped_facets = 0;             ///< minority side within each component
     std::uint64_t components_turned_outward = 0;  ///< closed components that were inside out
-    std::uint64_t nonmanifold_edges = 0;          ///< edges with more than two facets (then split)
-    std::uint64_t nonmanifold_vertices = 0;       ///< vertices with more than one fan (then split)
+    /// Closed components inside another an odd number of times: a cavity's shell, oriented
+    /// to face into the cavity (away from the material around it).
+    std::uint64_t cavities = 0;
+    std::uint64_t cavities_turned_inward = 0;  ///< of those, the ones that faced outward
+    /// Too many components to check which lies inside which (detail::kNestingWork): every
+    /// closed component was turned outward, a cavity's shell too.
+    bool nesting_unchecked = false;
+    std::uint64_t nonmanifold_edges = 0;     ///< edges with more than two facets (then split)
+    std::uint64_t nonmanifold_vertices = 0;  ///< vertices with more than one fan (then split)
     std::uint64_t orientation_conflicts =
         0;  ///< edges cut to make a non-orientable part orientable
 };
@@ -188,9 +195,10 @@ struct BuildResult {
 /// Builds the half-edge mesh from a soup, healing as ../shared/docs/method.md Step 1 says:
 /// exact weld, tolerance weld, degenerate and duplicate facets dropped, non-manifold edges
 /// and vertices split, facets oriented consistently per component (the minority flipped),
-/// closed components turned outward (positive volume). Deterministic: the same soup gives
-/// the same mesh whatever the thread count. Fails only when the soup cannot be addressed
-/// with 32-bit ids or a triangle names a point that does not exist.
+/// closed components turned outward (positive volume) and those inside another an odd number
+/// of times (a cavity's shell) inward, so that the signed volume is the material's. Deterministic:
+/// the same soup gives the same mesh whatever the thread count. Fails only when the soup cannot be
+/// addressed with 32-bit ids or a triangle names a point that does not exist.
 Result<BuildResult> build_mesh(const TriangleSoup& soup, const HealOptions& options = {},
                                const ProgressFn& progress = {});
 
@@ -205,6 +213,24 @@ MeshStats compute_stats(const Mesh& mesh);
 /// Each facet's component: facets joined across shared edges, numbered from 0 in the order of
 /// their first facet (MeshStats::components of them).
 std::vector<std::uint32_t> face_components(const Mesh& mesh);
+
+/// How the closed components of a mesh lie in one another: a cavity's shell inside its part,
+/// an island in the cavity inside both.
+struct ComponentNesting {
+    static constexpr std::uint32_t kNone = 0xffffffffu;
+    std::vector<std::uint32_t> component;  ///< per facet, as face_components() numbers them
+    std::vector<std::uint32_t> parent;  ///< per component: the closed one right around it, or kNone
+    /// Per component: how many closed components lie around it; odd: a cavity's shell.
+    std::vector<std::uint32_t> depth;
+    /// False when there were too many components to check (thousands of loose pieces in one
+    /// box): then none counts as nested.
+    bool complete = true;
+};
+
+/// Which closed component lies inside which, by the parity of ray crossings from one vertex
+/// (three rays, the majority), tested only where one's box lies in the other's. Open
+/// components are neither inside nor around anything.
+ComponentNesting component_nesting(const Mesh& mesh);
 
 /// Signed dihedral angle at the edge of `h`, in radians, in [-pi, pi]: the angle between the
 /// normals of its two facets, positive where the surface is convex (it bends away from the

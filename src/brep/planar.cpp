@@ -51,8 +51,9 @@ double distance_to_segment(Vec3 p, Vec3 a, Vec3 b) {
     return norm(p - (a + t * ab));
 }
 
-/// Fills topo.body and topo.bodies: faces that share a segment are one body.
-void number_bodies(PlanarTopology& topo) {
+/// Fills topo.body and topo.bodies: faces that share a segment are one body; and
+/// topo.void_of from the mesh's components' nesting, when given.
+void number_bodies(PlanarTopology& topo, const Mesh& m, const ComponentNesting* nesting) {
     const auto nf = static_cast<std::uint32_t>(topo.faces.size());
     detail::MinUnionFind bodies(nf);
     std::vector<std::uint32_t> face_of_segment(topo.segments.size(), kNone);
@@ -76,11 +77,33 @@ void number_bodies(PlanarTopology& topo) {
         if (n == kNone) n = topo.bodies++;
         topo.body[f] = n;
     }
+    topo.void_of.assign(topo.bodies, PlanarTopology::kNoBody);
+    topo.voids = 0;
+    if (!nesting || !topo.closed || topo.bodies < 2) return;
+    // A body is one mesh component (faces share segments where facets share edges); a vertex
+    // of its first face tells which.
+    std::vector<std::uint32_t> component(topo.bodies, kNone);
+    std::vector<std::uint32_t> body_of(nesting->parent.size(), kNone);
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        const std::uint32_t b = topo.body[f];
+        if (component[b] != kNone) continue;
+        const std::uint32_t seg = topo.faces[f].loops.front().edges.front().first;
+        const HalfedgeId h = m.outgoing(VertexId(topo.segments[seg][0]));
+        component[b] = nesting->component[h.idx() / 3];
+        body_of[component[b]] = b;
+    }
+    for (std::uint32_t b = 0; b < topo.bodies; ++b) {
+        const std::uint32_t c = component[b];
+        if (nesting->depth[c] % 2 == 0) continue;
+        topo.void_of[b] = body_of[nesting->parent[c]];
+        ++topo.voids;
+    }
 }
 
 }  // namespace
 
-PlanarTopology planar_topology(const Mesh& m, bool merge, double tol) {
+PlanarTopology planar_topology(const Mesh& m, bool merge, double tol,
+                               const ComponentNesting* nesting) {
     const std::size_t nf = m.num_faces(), nh = m.num_halfedges(), nv = m.num_vertices();
     PlanarTopology out;
 
@@ -335,7 +358,7 @@ PlanarTopology planar_topology(const Mesh& m, bool merge, double tol) {
     for (std::size_t hi = 0; hi < nh && out.closed; ++hi) {
         out.closed = !m.is_boundary(HalfedgeId(static_cast<std::uint32_t>(hi)));
     }
-    number_bodies(out);
+    number_bodies(out, m, nesting);
     return out;
 }
 
@@ -444,17 +467,22 @@ PlanarShape to_occt(const PlanarTopology& topo, const Mesh& m) {
         }
         builder.Add(shells[topo.body[k]], face);
     }
+    // A void's shell goes into the solid around it, its faces facing into the void.
     std::vector<TopoDS_Shape> bodies;
-    for (TopoDS_Shell& shell : shells) {
-        shell.Closed(topo.closed);
-        if (topo.closed) {
-            TopoDS_Solid solid;
-            builder.MakeSolid(solid);
-            builder.Add(solid, shell);
-            bodies.push_back(solid);
-        } else {
-            bodies.push_back(shell);
+    std::vector<TopoDS_Solid> solids(topo.bodies);
+    for (std::uint32_t b = 0; b < topo.bodies; ++b) {
+        shells[b].Closed(topo.closed);
+        if (!topo.closed) {
+            bodies.push_back(shells[b]);
+        } else if (topo.void_of[b] == PlanarTopology::kNoBody) {
+            builder.MakeSolid(solids[b]);
+            builder.Add(solids[b], shells[b]);
+            bodies.push_back(solids[b]);
         }
+    }
+    for (std::uint32_t b = 0; b < topo.bodies && topo.closed; ++b) {
+        if (topo.void_of[b] != PlanarTopology::kNoBody)
+            builder.Add(solids[topo.void_of[b]], shells[b]);
     }
     out.solid = topo.closed;
     if (bodies.size() == 1) {

@@ -35,12 +35,20 @@ struct PlanarTopology {
     /// components (parts side by side) has several bodies, each a shell (a solid when closed).
     std::vector<std::uint32_t> body;
     std::uint32_t bodies = 0;
+    /// Per body: the body whose solid it is a void of (a cavity's shell, facing into the
+    /// cavity), or kNoBody for a body that is a solid (or shell) of its own.
+    std::vector<std::uint32_t> void_of;
+    static constexpr std::uint32_t kNoBody = 0xffffffffu;
+    std::uint32_t voids = 0;
 };
 
 /// `merge` false: one face per facet (the paper's method 1). `merge` true: coplanar
 /// neighbours within `tol` (model units) become one face, boundary runs within `tol` of a
-/// straight line one edge.
-PlanarTopology planar_topology(const Mesh& mesh, bool merge, double tol);
+/// straight line one edge. `nesting`: the mesh's component_nesting(), when it has several
+/// closed components (a closed component inside another an odd number of times becomes a void
+/// of the body around it); null: none nested.
+PlanarTopology planar_topology(const Mesh& mesh, bool merge, double tol,
+                               const ComponentNesting* nesting = nullptr);
 
 /// Structural check in O(n): loops closed and chained end to start, every segment used twice
 /// in opposite directions (once, on an open mesh's boundary), segments of positive length,
@@ -54,8 +62,8 @@ void measure_topology(const PlanarTopology& topology, const Mesh& mesh, double& 
                       double& volume);
 
 struct PlanarShape {
-    TopoDS_Shape shape;  ///< a solid per body when the mesh is closed, else a shell per body;
-                         ///< several in a compound
+    TopoDS_Shape shape;  ///< a solid per body when the mesh is closed (its voids' shells inside
+                         ///< it), else a shell per body; several in a compound
     bool solid = false;
 };
 

@@ -171,8 +171,11 @@ Result<ReverseReport> reverse_planar(const Mesh& mesh, const MeshStats& stats,
     brep_detail::silence_occt();
     brep_detail::PlanarTopology topo;
     stage("brep", [&] {
+        // Several closed components: which are cavities (voids of the solid around them).
+        std::optional<ComponentNesting> nesting;
+        if (stats.closed && stats.components > 1) nesting = component_nesting(mesh);
         topo = brep_detail::planar_topology(mesh, options.method != ReverseMethod::kFacets,
-                                            rep.planar_tolerance);
+                                            rep.planar_tolerance, nesting ? &*nesting : nullptr);
     });
     rep.faces = topo.faces.size();
     rep.edges = topo.segments.size();
@@ -183,7 +186,8 @@ Result<ReverseReport> reverse_planar(const Mesh& mesh, const MeshStats& stats,
     }
     rep.faces_by_kind["plane"] = rep.faces;
     rep.solid = topo.closed;
-    rep.bodies = topo.bodies;
+    rep.bodies = topo.bodies - topo.voids;
+    rep.voids = topo.voids;
     std::string problem;
     try {
         stage("check", [&] {
@@ -540,9 +544,11 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
             TopExp::MapShapes(brep.shape, TopAbs_FACE, faces);
             TopExp::MapShapes(brep.shape, TopAbs_EDGE, edges);
             TopExp::MapShapes(brep.shape, TopAbs_VERTEX, vertices);
-            TopTools_IndexedMapOfShape bodies;
+            TopTools_IndexedMapOfShape bodies, shells;
             TopExp::MapShapes(brep.shape, brep.solid ? TopAbs_SOLID : TopAbs_SHELL, bodies);
+            TopExp::MapShapes(brep.shape, TopAbs_SHELL, shells);
             rep.bodies = static_cast<std::uint64_t>(bodies.Extent());
+            if (brep.solid) rep.voids = static_cast<std::uint64_t>(shells.Extent()) - rep.bodies;
             rep.faces = static_cast<std::uint64_t>(faces.Extent());
             rep.edges = static_cast<std::uint64_t>(edges.Extent());
             rep.vertices = static_cast<std::uint64_t>(vertices.Extent());
@@ -699,80 +705,6 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     }
 }
 
-// Ray-triangle tests nested_component() makes at most, a bound on its work: a part with
-// thousands of small loose components in its box would otherwise cost components x facets.
-constexpr std::uint64_t kNestingWork = 300'000'000;
-
-// A closed component of `mesh` that lies inside another closed one (a cavity), if any:
-// "component A lies inside component B", else empty. Healing turns every closed component
-// outward, so a cavity's shell would come back as a solid of its own filling it; nested
-// bodies are not built yet. Components by shared edges; a component is inside another when
-// a ray from one of its vertices crosses the other's facets an odd number of times (the
-// majority of three rays, for rays that graze an edge), tested only where its box lies in
-// the other's. `skipped`: set when the check stopped at kNestingWork (nothing found so far).
-std::string nested_component(const Mesh& mesh, const MeshStats& stats, bool* skipped) {
-    if (stats.components < 2) return {};
-    const std::uint32_t nf = mesh.num_faces();
-    const std::vector<std::uint32_t> comp = face_components(mesh);
-    const auto count = static_cast<std::uint32_t>(stats.components);
-    std::vector<std::vector<std::uint32_t>> facets(count);
-    std::vector<std::uint8_t> open(count, 0);  // a boundary edge
-    std::vector<Box3> box(count);
-    for (std::uint32_t f = 0; f < nf; ++f) {
-        facets[comp[f]].push_back(f);
-        for (int i = 0; i < 3; ++i) {
-            box[comp[f]].add(mesh.position(mesh.vertex(FaceId(f), i)));
-            open[comp[f]] |= !mesh.twin(Mesh::halfedge(FaceId(f), i)).is_valid();
-        }
-    }
-    const auto inside_box = [](const Box3& a, const Box3& b) {
-        return a.min.x >= b.min.x && a.min.y >= b.min.y && a.min.z >= b.min.z &&
-               a.max.x <= b.max.x && a.max.y <= b.max.y && a.max.z <= b.max.z;
-    };
-    // Directions no mesh of a machined part lines up with.
-    const std::array<Vec3, 3> rays{normalized(Vec3{0.5773, 0.4082, 0.7071}),
-                                   normalized(Vec3{-0.3162, 0.8944, 0.3169}),
-                                   normalized(Vec3{0.6325, -0.2236, -0.7416})};
-    std::uint64_t work = 0;
-    for (std::uint32_t a = 0; a < count; ++a) {
-        for (std::uint32_t b = 0; b < count; ++b) {
-            if (a == b || open[a] || open[b] || !inside_box(box[a], box[b])) continue;
-            work += rays.size() * facets[b].size();
-            if (work > kNestingWork) {
-                if (skipped) *skipped = true;
-                return {};
-            }
-            // From a vertex of a (a component lies wholly inside another or outside it).
-            const Vec3 o = mesh.position(mesh.vertex(FaceId(facets[a].front()), 0));
-            int odd = 0;
-            for (const Vec3& d : rays) {
-                std::uint64_t hits = 0;
-                for (const std::uint32_t f : facets[b]) {
-                    const Vec3 p0 = mesh.position(mesh.vertex(FaceId(f), 0));
-                    const Vec3 e1 = mesh.position(mesh.vertex(FaceId(f), 1)) - p0;
-                    const Vec3 e2 = mesh.position(mesh.vertex(FaceId(f), 2)) - p0;
-                    const Vec3 q = cross(d, e2);
-                    const double det = dot(e1, q);
-                    if (det == 0) continue;
-                    const Vec3 s = o - p0;
-                    const double u = dot(s, q) / det;
-                    if (u < 0 || u > 1) continue;
-                    const Vec3 r = cross(s, e1);
-                    const double v = dot(d, r) / det;
-                    if (v < 0 || u + v > 1) continue;
-                    if (dot(e2, r) / det > 0) ++hits;
-                }
-                odd += static_cast<int>(hits % 2);
-            }
-            if (2 * odd > static_cast<int>(rays.size())) {
-                return "component " + std::to_string(a) + " lies inside component " +
-                       std::to_string(b);
-            }
-        }
-    }
-    return {};
-}
-
 }  // namespace
 
 Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::path& output,
@@ -790,19 +722,6 @@ Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::p
     const MeshStats stats = compute_stats(mesh);
     rep.mesh_volume = stats.volume;
     rep.mesh_area = stats.area;
-    bool unchecked = false;
-    const std::string nested = nested_component(mesh, stats, &unchecked);
-    if (unchecked) {
-        rep.warnings.push_back(
-            "too many components to check whether one lies inside another (a cavity, which "
-            "would be built as a solid of its own)");
-    }
-    if (!nested.empty()) {
-        rep.warnings.push_back("the mesh has a closed part inside another (" + nested +
-                               ": a cavity, or a part inside a part); nested bodies are not "
-                               "built yet: nothing written");
-        return rep;
-    }
     const bool surfaces =
         options.method == ReverseMethod::kAuto || options.method == ReverseMethod::kSurfaces;
     if (surfaces && stats.closed) return reverse_surfaces(mesh, stats, output, options, rep);

@@ -3,6 +3,7 @@
 // one streams the entities. Entities: CARTESIAN_POINT, VERTEX_POINT, DIRECTION, VECTOR, LINE,
 // EDGE_CURVE, ORIENTED_EDGE, EDGE_LOOP, FACE_(OUTER_)BOUND, AXIS2_PLACEMENT_3D, PLANE,
 // ADVANCED_FACE, CLOSED_SHELL / OPEN_SHELL, MANIFOLD_SOLID_BREP / SHELL_BASED_SURFACE_MODEL,
+// BREP_WITH_VOIDS and ORIENTED_CLOSED_SHELL for a solid with cavities,
 // with the product and unit context of AP214 (AP203 and AP242 name their schema). Tests read
 // every file back with STEPControl_Reader and check it with BRepCheck_Analyzer.
 #include <unistd.h>
@@ -262,7 +263,13 @@ Status write_planar_step(const PlanarTopology& topo, const Mesh& m,
     }
     std::vector<std::uint64_t> faces, bounds, oriented;
     faces.reserve(topo.faces.size());
-    for (const PlanarTopology::Face& f : topo.faces) {
+    for (std::size_t fi = 0; fi < topo.faces.size(); ++fi) {
+        const PlanarTopology::Face& f = topo.faces[fi];
+        // A void's shell is written facing into the material and used reversed
+        // (ORIENTED_CLOSED_SHELL .F., as ISO 10303-42 wants a void): each face reversed, its
+        // bounds with it.
+        const bool in_void = topo.closed && topo.void_of[topo.body[fi]] != PlanarTopology::kNoBody;
+        const char* sense = in_void ? ",.F.);\n" : ",.T.);\n";
         bounds.clear();
         for (std::size_t li = 0; li < f.loops.size(); ++li) {
             oriented.clear();
@@ -282,7 +289,7 @@ Status write_planar_step(const PlanarTopology& topo, const Mesh& m,
             bounds.push_back(st.begin());
             st.raw(li == 0 ? "FACE_OUTER_BOUND(''," : "FACE_BOUND('',");
             st.ref(loop);
-            st.raw(",.T.);\n");
+            st.raw(sense);
         }
         // Any direction orthogonal to the normal serves as the plane's x axis.
         const Vec3 n = f.normal;
@@ -311,7 +318,7 @@ Status write_planar_step(const PlanarTopology& topo, const Mesh& m,
         }
         st.raw("),");
         st.ref(plane);
-        st.raw(",.T.);\n");
+        st.raw(sense);
         if (auto s = st.flush_if_large(*file); !s) return s;
     }
     // A shell per body (a mesh of several components: parts side by side), each a solid when
@@ -341,10 +348,27 @@ Status write_planar_step(const PlanarTopology& topo, const Mesh& m,
     st.raw(");\n");
     std::vector<std::uint64_t> bodies;
     if (topo.closed) {
-        for (const auto& shell : shells) {
+        std::vector<std::vector<std::uint64_t>> voids(topo.bodies);
+        for (std::uint32_t b = 0; b < topo.bodies; ++b) {
+            if (topo.void_of[b] == PlanarTopology::kNoBody) continue;
+            voids[topo.void_of[b]].push_back(st.begin());
+            st.raw("ORIENTED_CLOSED_SHELL('',*,");
+            st.ref(shells[b]);
+            st.raw(",.F.);\n");
+        }
+        for (std::uint32_t b = 0; b < topo.bodies; ++b) {
+            if (topo.void_of[b] != PlanarTopology::kNoBody) continue;
             bodies.push_back(st.begin());
-            st.raw("MANIFOLD_SOLID_BREP(" + name + ",");
-            st.ref(shell);
+            st.raw((voids[b].empty() ? "MANIFOLD_SOLID_BREP(" : "BREP_WITH_VOIDS(") + name + ",");
+            st.ref(shells[b]);
+            if (!voids[b].empty()) {
+                st.raw(",(");
+                for (std::size_t k = 0; k < voids[b].size(); ++k) {
+                    if (k) st.raw(",");
+                    st.ref(voids[b][k]);
+                }
+                st.raw(")");
+            }
             st.raw(");\n");
         }
     } else {

@@ -25,12 +25,15 @@
 #include <BRepBuilderAPI_Copy.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepClass3d_SolidClassifier.hxx>
+#include <BRepGProp.hxx>
 #include <BRepLib.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <ElSLib.hxx>
 #include <GCPnts_AbscissaPoint.hxx>
+#include <GProp_GProps.hxx>
 #include <Geom2d_Line.hxx>
 #include <GeomAPI_IntSS.hxx>
 #include <GeomAPI_Interpolate.hxx>
@@ -1905,7 +1908,9 @@ struct GeometryCache {
 
 /// The closed shell `shell` as solids, one per connected piece (faces joined by shared edges):
 /// a mesh of several components (parts side by side) gives several, in a compound; one gives
-/// the solid of `shell` itself. Each face keeps its orientation in the shell.
+/// the solid of `shell` itself. A piece that bounds a negative volume is a cavity's shell
+/// (healing faces it into the cavity): it goes into the smallest solid that holds one of its
+/// vertices, as a void. Each face keeps its orientation in the shell.
 TopoDS_Shape solids_of(const TopoDS_Shell& shell) {
     BRep_Builder B;
     std::vector<TopoDS_Shape> members;
@@ -1936,10 +1941,58 @@ TopoDS_Shape solids_of(const TopoDS_Shell& shell) {
         return solid;
     };
     if (pieces.size() <= 1) return solid_of(shell);
+    struct Piece {
+        TopoDS_Shell shell;
+        TopoDS_Solid solid;
+        double volume = 0;
+        std::vector<TopoDS_Shell> voids;
+    };
+    std::vector<Piece> all_pieces;
+    for (const auto& [r, sh] : pieces) {
+        Piece p{sh, solid_of(sh), 0, {}};
+        GProp_GProps props;
+        BRepGProp::VolumeProperties(p.solid, props);
+        p.volume = props.Mass();
+        all_pieces.push_back(std::move(p));
+    }
+    std::vector<std::uint8_t> placed(all_pieces.size(), 0);
+    for (std::size_t v = 0; v < all_pieces.size(); ++v) {
+        if (all_pieces[v].volume >= 0) continue;
+        TopExp_Explorer vertex(all_pieces[v].shell, TopAbs_VERTEX);
+        if (!vertex.More()) continue;
+        const gp_Pnt p = BRep_Tool::Pnt(TopoDS::Vertex(vertex.Current()));
+        std::size_t around = all_pieces.size();
+        for (std::size_t o = 0; o < all_pieces.size(); ++o) {
+            if (all_pieces[o].volume <= 0) continue;
+            if (around < all_pieces.size() && all_pieces[o].volume >= all_pieces[around].volume)
+                continue;
+            BRepClass3d_SolidClassifier in(all_pieces[o].solid, p, Precision::Confusion());
+            if (in.State() == TopAbs_IN) around = o;
+        }
+        if (around == all_pieces.size()) continue;  // not inside a piece: a solid of its own
+        all_pieces[around].voids.push_back(all_pieces[v].shell);
+        placed[v] = 1;
+    }
     TopoDS_Compound all;
     B.MakeCompound(all);
-    for (const auto& [r, sh] : pieces) B.Add(all, solid_of(sh));
-    return all;
+    std::size_t solids = 0;
+    TopoDS_Shape last;
+    for (std::size_t k = 0; k < all_pieces.size(); ++k) {
+        if (placed[k]) continue;
+        Piece& p = all_pieces[k];
+        if (!p.voids.empty()) {
+            B.MakeSolid(p.solid);
+            B.Add(p.solid, p.shell);
+            for (TopoDS_Shell& hole : p.voids) {
+                hole.Closed(true);
+                B.Add(p.solid, hole);
+            }
+        }
+        B.Add(all, p.solid);
+        last = p.solid;
+        ++solids;
+    }
+    return solids == 1 ? last : TopoDS_Shape(all);
 }
 
 }  // namespace

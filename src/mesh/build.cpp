@@ -1,7 +1,8 @@
 // Building the half-edge mesh from a facet soup, with healing (../shared/docs/method.md,
 // Step 1): exact weld, tolerance weld, degenerate and duplicate facets dropped, edges paired
 // (non-manifold edges split by the angular order of their facets), facets oriented per
-// component, closed components turned outward, non-manifold vertices split.
+// component, closed components turned outward (a cavity's shell inward), non-manifold vertices
+// split.
 //
 // Determinism: every parallel loop writes only its own slots over fixed chunks, and every
 // choice (which point represents a weld, which facet of a duplicate pair stays, which facets
@@ -18,6 +19,7 @@
 
 #include "detail/exact_weld.h"
 #include "detail/huge_pages.h"
+#include "detail/nesting.h"
 #include "detail/union_find.h"
 #include "ncrev/mesh.h"
 
@@ -688,7 +690,7 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
             rep.flipped_facets += flipped[c];
         }
         // Turn closed components outward: positive signed volume (about the box center, for
-        // precision).
+        // precision), a cavity's shell inward.
         const Vec3 center = box.empty() ? Vec3{} : 0.5 * (box.min + box.max);
         std::vector<double> volume6(num_comp, 0.0);
         std::vector<std::uint8_t> open(num_comp, 0);
@@ -702,11 +704,25 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
             if (flip[f]) std::swap(p1, p2);
             volume6[c] += dot(p0, cross(p1, p2));
         }
+        // A closed component inside another an odd number of times is a cavity's shell: it
+        // faces into the cavity (negative volume), away from the material around it.
+        std::vector<std::uint8_t> closed(num_comp, 0);
+        for (std::size_t c = 0; c < num_comp; ++c) closed[c] = !open[c];
+        const detail::Nesting nesting = detail::nest_components(
+            comp, static_cast<std::uint32_t>(num_comp), closed, [&](std::uint32_t f) {
+                return std::array<Vec3, 3>{vpos[corner[3 * std::size_t{f}]],
+                                           vpos[corner[3 * std::size_t{f} + 1]],
+                                           vpos[corner[3 * std::size_t{f} + 2]]};
+            });
+        rep.nesting_unchecked = !nesting.complete;
         std::vector<std::uint8_t> turn(num_comp, 0);
         for (std::size_t c = 0; c < num_comp; ++c) {
-            if (!open[c] && volume6[c] < 0) {
+            if (open[c]) continue;
+            const bool cavity = nesting.depth[c] % 2 == 1;
+            rep.cavities += cavity;
+            if ((volume6[c] < 0) != cavity) {
                 turn[c] = 1;
-                ++rep.components_turned_outward;
+                ++(cavity ? rep.cavities_turned_inward : rep.components_turned_outward);
             }
         }
         for (std::size_t f = 0; f < nf; ++f) flip[f] ^= turn[comp[f]];

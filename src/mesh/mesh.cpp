@@ -2,9 +2,11 @@
 #include "ncrev/mesh.h"
 
 #include <algorithm>
+#include <array>
 #include <numeric>
 
 #include "detail/huge_pages.h"
+#include "detail/nesting.h"
 
 namespace ncrev {
 
@@ -102,6 +104,28 @@ std::vector<std::uint32_t> face_components(const Mesh& mesh) {
         }
     }
     return comp;
+}
+
+ComponentNesting component_nesting(const Mesh& mesh) {
+    ComponentNesting out;
+    out.component = face_components(mesh);
+    const std::uint32_t count =
+        out.component.empty() ? 0
+                              : *std::max_element(out.component.begin(), out.component.end()) + 1;
+    std::vector<std::uint8_t> closed(count, 1);
+    for (std::size_t h = 0; h < mesh.num_halfedges(); ++h) {
+        if (mesh.twins()[h] == HalfedgeId::kInvalid) closed[out.component[h / 3]] = 0;
+    }
+    detail::Nesting n = detail::nest_components(out.component, count, closed, [&](std::uint32_t f) {
+        return std::array<Vec3, 3>{mesh.position(mesh.vertex(FaceId(f), 0)),
+                                   mesh.position(mesh.vertex(FaceId(f), 1)),
+                                   mesh.position(mesh.vertex(FaceId(f), 2))};
+    });
+    static_assert(ComponentNesting::kNone == detail::kNotNested);
+    out.parent = std::move(n.parent);
+    out.depth = std::move(n.depth);
+    out.complete = n.complete;
+    return out;
 }
 
 MeshStats compute_stats(const Mesh& mesh) {

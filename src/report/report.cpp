@@ -31,6 +31,15 @@ std::vector<std::string> make_warnings(const InfoReport& r) {
     if (r.heal.components_turned_outward) {
         w.push_back(n(r.heal.components_turned_outward) + " inside-out components turned outward");
     }
+    if (r.heal.cavities_turned_inward) {
+        w.push_back(n(r.heal.cavities_turned_inward) +
+                    " cavity shells turned inward (they faced out of the cavity)");
+    }
+    if (r.heal.nesting_unchecked) {
+        w.push_back(
+            "too many components to check which lies inside which: a cavity's shell, if any, "
+            "is turned outward and the volume counts it as material");
+    }
     if (r.heal.nonmanifold_edges)
         w.push_back(n(r.heal.nonmanifold_edges) + " non-manifold edges split");
     if (r.heal.nonmanifold_vertices) {
@@ -127,6 +136,9 @@ nlohmann::json info_json(const InfoReport& r) {
                     {"duplicate_facets_removed", h.duplicate_facets_removed},
                     {"flipped_facets", h.flipped_facets},
                     {"components_turned_outward", h.components_turned_outward},
+                    {"cavities", h.cavities},
+                    {"cavities_turned_inward", h.cavities_turned_inward},
+                    {"nesting_checked", !h.nesting_unchecked},
                     {"nonmanifold_edges", h.nonmanifold_edges},
                     {"nonmanifold_vertices", h.nonmanifold_vertices},
                     {"orientation_conflicts", h.orientation_conflicts}};
@@ -171,6 +183,7 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
                     {"vertices", rev.vertices},
                     {"solid", rev.solid},
                     {"bodies", rev.bodies},
+                    {"voids", rev.voids},
                     {"valid", rev.valid},
                     {"occt_checked", rev.occt_checked},
                     {"closed_valid_solid", rev.solid && rev.valid},
@@ -462,6 +475,13 @@ std::string to_text(const InfoReport& r) {
         static_cast<unsigned long long>(m.boundary_edges),
         static_cast<long long>(m.euler_characteristic));
     s += buf;
+    if (h.cavities) {
+        std::snprintf(buf, sizeof buf,
+                      "cavities: %llu (closed components inside a part, each a void in its "
+                      "solid)\n",
+                      static_cast<unsigned long long>(h.cavities));
+        s += buf;
+    }
     if (!m.bbox.empty()) {
         const Vec3 d = m.bbox.max - m.bbox.min;
         std::snprintf(buf, sizeof buf,
