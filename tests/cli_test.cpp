@@ -263,6 +263,21 @@ TEST(CliReverse, OpenMeshWithRequireSolidExitsThreeAndWritesNothing) {
     EXPECT_NE(shell.err.find("warning: the mesh is open"), std::string::npos) << shell.err;
     std::filesystem::remove(step);
     std::filesystem::remove(stl);
+    // A closed cube with a stray facet beside it: the cube is the solid, the facet left out.
+    auto stray = test::cube({0, 0, 0}, 10.0);
+    const auto base = static_cast<std::uint32_t>(stray.points.size());
+    stray.points.insert(stray.points.end(), {{20, 0, 0}, {21, 0, 0}, {20, 1, 0}});
+    stray.triangles.push_back({base, base + 1, base + 2});
+    const auto with_stray =
+        write_temp("ncrev_cli_rev_stray.stl", encode_stl_binary(stray.points, stray.triangles));
+    const CliRun solid =
+        run("reverse " + with_stray.string() + " -o " + step.string() + " --require-solid");
+    EXPECT_EQ(solid.code, 0) << solid.err;
+    EXPECT_NE(solid.err.find("1 open component of the mesh (1 facet"), std::string::npos)
+        << solid.err;
+    EXPECT_NE(solid.err.find("closed solid"), std::string::npos) << solid.err;
+    std::filesystem::remove(step);
+    std::filesystem::remove(with_stray);
 }
 
 // The default method on the bundled example: the true faces, the extended report, labels in

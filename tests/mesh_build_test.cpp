@@ -164,6 +164,33 @@ TEST(MeshBuild, TurnsACavitysShellIntoTheCavity) {
     EXPECT_EQ(build_ok(balls(0, {false, false, false}), keep).heal.cavities, 0u);
 }
 
+// A mesh of some of the components: valid on its own, each face with its input facet.
+TEST(MeshBuild, KeepsWholeComponentsAsAMeshOfTheirOwn) {
+    test::Indexed m = test::merge(test::cube({0, 0, 0}, 1.0), test::icosphere(1.0, 1, {5, 0, 0}));
+    m = test::merge(m, test::cube({9, 0, 0}, 1.0));
+    m.triangles.erase(m.triangles.begin() + 12);  // the ball is open now
+    const BuildResult b = build_ok(test::to_indexed_soup(m));
+    const std::vector<std::uint32_t> comp = face_components(b.mesh);
+    std::vector<std::uint8_t> keep = {1, 0, 1};
+    const Mesh cubes = keep_components(b.mesh, comp, keep);
+    EXPECT_EQ(cubes.validate(), "");
+    EXPECT_EQ(cubes.num_faces(), 24u);
+    EXPECT_EQ(cubes.num_vertices(), 16u);
+    const MeshStats s = compute_stats(cubes);
+    EXPECT_TRUE(s.closed);
+    EXPECT_EQ(s.components, 2u);
+    EXPECT_DOUBLE_EQ(s.volume, 2.0);
+    std::uint32_t k = 0;
+    for (std::uint32_t f = 0; f < b.mesh.num_faces(); ++f) {
+        if (!keep[comp[f]]) continue;
+        EXPECT_EQ(cubes.source_face(FaceId(k++)), b.mesh.source_face(FaceId(f)));
+    }
+    keep = {0, 1, 0};
+    const Mesh ball = keep_components(b.mesh, comp, keep);
+    EXPECT_EQ(ball.validate(), "");
+    EXPECT_EQ(compute_stats(ball).boundary_loops, 1u);
+}
+
 TEST(MeshBuild, RemovesDuplicateFacetsInAnyOrderOrOrientation) {
     auto m = test::cube();
     m.triangles.push_back(m.triangles[0]);

@@ -440,6 +440,115 @@ TEST(ReverseSurfaces, OpenMeshIsPlanarInAutoAndNothingInSurfaces) {
     EXPECT_FALSE(a->solid);
 }
 
+// A closed part with stray open pieces beside it (a loose facet, a scrap of a sheet, as exports
+// and repairs leave them): auto and surfaces build the part and leave the open pieces out, with
+// a warning, their facets labelled -1. Until the forty-fourth session the whole mesh, being
+// open, went planar as a surface model. An open part with a small closed piece stays planar.
+TEST(ReverseSurfaces, StrayOpenPiecesAreLeftOutOfTheSolid) {
+    const SamplePart part = make("slot_plate", kFine);
+    Box3 box;
+    for (const Vec3& p : part.mesh.points) box.add(p);
+    const double size = box.diagonal();
+    TriangleSoup soup = part.mesh;
+    const auto add = [&](Vec3 a, Vec3 b, Vec3 c) {
+        const auto base = static_cast<std::uint32_t>(soup.points.size());
+        soup.points.insert(soup.points.end(), {a, b, c});
+        soup.triangles.push_back({base, base + 1, base + 2});
+        if (!soup.color.empty()) {
+            soup.color.push_back(soup.color.back());
+            soup.cut.push_back(soup.cut.back());
+            soup.surface.push_back(soup.surface.back());
+        }
+    };
+    // A loose facet and a two-facet scrap, a part's length away.
+    const Vec3 o = box.max + Vec3{size, 0, 0};
+    const double s = 0.05 * size;
+    add(o, o + Vec3{s, 0, 0}, o + Vec3{0, s, 0});
+    add(o + Vec3{0, 0, s}, o + Vec3{s, 0, s}, o + Vec3{s, s, s});
+    add(o + Vec3{0, 0, s}, o + Vec3{s, s, s}, o + Vec3{0, s, s});
+    const std::size_t stray = 3;
+    const Outcome whole = reverse_part(part, false, ReverseMethod::kAuto, "stray_reference");
+    for (const ReverseMethod method : {ReverseMethod::kAuto, ReverseMethod::kSurfaces}) {
+        const std::string tag = method == ReverseMethod::kAuto ? "stray_auto" : "stray_surfaces";
+        TriangleSoup stl = soup;
+        stl.color.clear();
+        stl.cut.clear();
+        stl.surface.clear();
+        stl.surfaces.clear();
+        stl.tools.clear();
+        Result<BuildResult> built = build_mesh(std::move(stl));
+        ASSERT_TRUE(built.ok());
+        const auto path = out_dir() / (tag + ".step");
+        ReverseOptions ro;
+        ro.method = method;
+        ro.require_solid = true;
+        Result<ReverseReport> r = reverse_to_step(built->mesh, path, ro);
+        ASSERT_TRUE(r.ok()) << tag;
+        EXPECT_TRUE(r->written && r->solid && r->valid) << tag;
+        EXPECT_EQ(r->left_out_facets, stray) << tag;
+        EXPECT_EQ(r->faces, whole.report.faces) << tag;
+        EXPECT_EQ(r->faces_by_kind, whole.report.faces_by_kind) << tag;
+        EXPECT_DOUBLE_EQ(r->mesh_volume, whole.report.mesh_volume) << tag;
+        ASSERT_FALSE(r->warnings.empty());
+        EXPECT_NE(r->warnings.front().find("left out"), std::string::npos) << r->warnings.front();
+        const test::ReadBack back = test::read_step(path);
+        EXPECT_TRUE(back.valid) << tag;
+        EXPECT_EQ(back.solids, 1u) << tag;
+        EXPECT_NEAR(back.volume, part.solid.volume, 1e-3 * part.solid.volume) << tag;
+        // Labels in input order: the part's facets have regions, the stray ones none.
+        ASSERT_TRUE(r->segmentation.has_value());
+        const std::vector<std::int32_t> labels =
+            input_labels(built->mesh, *r->segmentation, soup.triangles.size());
+        for (std::size_t i = 0; i < labels.size(); ++i) {
+            if (i < part.mesh.triangles.size()) {
+                EXPECT_GE(labels[i], 0) << tag << " facet " << i;
+            } else {
+                EXPECT_EQ(labels[i], -1) << tag << " facet " << i;
+            }
+        }
+        std::filesystem::remove(path);
+    }
+    // Mostly open: the part with most of its facets gone, beside a closed cube. Planar as a
+    // whole (shells), and nothing with require_solid.
+    TriangleSoup open = part.mesh;
+    open.triangles.resize(open.triangles.size() / 2);
+    open.color.clear();
+    open.cut.clear();
+    open.surface.clear();
+    open.surfaces.clear();
+    open.tools.clear();
+    {
+        const auto base = static_cast<std::uint32_t>(open.points.size());
+        const double c = 0.01 * size;
+        for (int k = 0; k < 8; ++k)
+            open.points.push_back(o + Vec3{k & 1 ? c : 0, k & 2 ? c : 0, k & 4 ? c : 0});
+        for (const auto& q : std::array<std::array<std::uint32_t, 4>, 6>{{{0, 2, 3, 1},
+                                                                          {4, 5, 7, 6},
+                                                                          {0, 1, 5, 4},
+                                                                          {2, 6, 7, 3},
+                                                                          {0, 4, 6, 2},
+                                                                          {1, 3, 7, 5}}}) {
+            open.triangles.push_back({base + q[0], base + q[1], base + q[2]});
+            open.triangles.push_back({base + q[0], base + q[2], base + q[3]});
+        }
+    }
+    Result<BuildResult> built = build_mesh(std::move(open));
+    ASSERT_TRUE(built.ok());
+    const auto path = out_dir() / "mostly_open.step";
+    ReverseOptions ro;
+    Result<ReverseReport> r = reverse_to_step(built->mesh, path, ro);
+    ASSERT_TRUE(r.ok());
+    EXPECT_TRUE(r->written);
+    EXPECT_FALSE(r->solid);
+    EXPECT_EQ(r->left_out_facets, 0u);
+    std::filesystem::remove(path);
+    ro.require_solid = true;
+    r = reverse_to_step(built->mesh, path, ro);
+    ASSERT_TRUE(r.ok());
+    EXPECT_FALSE(r->written);
+    EXPECT_FALSE(std::filesystem::exists(path));
+}
+
 // Same mesh, same STEP, whatever the run and the thread count.
 TEST(ReverseSurfaces, Deterministic) {
     const SamplePart part = make("fillet_chamfer_block", kFine);
@@ -878,7 +987,7 @@ TEST(ReverseSurfaces, PartsSideBySideAreSolidsOfTheirOwn) {
 // BREP_WITH_VOIDS). Until the forty-fourth session healing turned it outward, so a cavity would
 // have come back as a solid filling it, and such meshes were refused. A part inside the cavity
 // is a solid of its own; side by side the same shells are two solids; an open sheet inside
-// has no inside and stays a shell.
+// has no inside: a shell (planar), or left out of the cube's solid (auto).
 TEST(ReverseSurfaces, ACavityIsAVoidOfItsSolid) {
     TriangleSoup soup;
     const auto cube = [&](Vec3 lo, Vec3 hi, bool inward) {
@@ -1006,7 +1115,7 @@ TEST(ReverseSurfaces, ACavityIsAVoidOfItsSolid) {
         EXPECT_NEAR(o.second.volume, exact, 1e-3 * exact);
         EXPECT_LT(o.second.volume, o.first.mesh_volume);
     }
-    // Side by side: two solids, no void; an open sheet inside: shells.
+    // Side by side: two solids, no void; an open sheet inside: shells, or left out (auto).
     soup = {};
     cube({0, 0, 0}, {10, 10, 10}, false);
     cube({23, 3, 3}, {27, 7, 7}, true);
@@ -1028,9 +1137,17 @@ TEST(ReverseSurfaces, ACavityIsAVoidOfItsSolid) {
         const std::string tag = std::string("sheet_") + name(method);
         const auto [o, heal] = reverse(method, tag);
         EXPECT_EQ(heal.cavities, 0u) << tag;
-        EXPECT_TRUE(o.first.written && !o.first.solid) << tag;
-        EXPECT_EQ(o.first.bodies, 2u) << tag;
         EXPECT_EQ(o.first.voids, 0u) << tag;
+        if (method == ReverseMethod::kAuto) {
+            // The closed cube is most of the mesh: built, the sheet left out (and said).
+            EXPECT_TRUE(o.first.written && o.first.solid) << tag;
+            EXPECT_EQ(o.first.bodies, 1u) << tag;
+            EXPECT_EQ(o.first.left_out_facets, 11u) << tag;
+            EXPECT_NEAR(o.second.volume, 1000, 1e-6) << tag;
+        } else {
+            EXPECT_TRUE(o.first.written && !o.first.solid) << tag;
+            EXPECT_EQ(o.first.bodies, 2u) << tag;
+        }
     }
 }
 

@@ -85,8 +85,10 @@ void add_reverse(CLI::App& app, Context& ctx) {
                     "Write a JSON report: stages with timings, healing, regions, faces by kind, "
                     "fallbacks, edges, vertices, whether the result is a closed valid solid, "
                     "volumes, areas and the deviation between the solid and the mesh");
-    cmd->add_flag("--require-solid", o->require_solid,
-                  "Fail (exit 3, nothing written) unless the result is a closed solid");
+    cmd->add_flag(
+        "--require-solid", o->require_solid,
+        "Fail (exit 3, nothing written) unless the result is closed solids (an open mesh's "
+        "closed components are, with auto and surfaces, when they are most of it)");
     cmd->add_flag("--json", o->json, "Print the report (as --report writes it) on stdout");
     cmd->add_flag("-q,--quiet", o->quiet, "No warnings and no progress on stderr");
     cmd->callback([o, &ctx]() {
@@ -114,13 +116,6 @@ void add_reverse(CLI::App& app, Context& ctx) {
             }
         }
         const auto progress = terminal_progress(ctx, o->quiet);
-        if (o->require_solid && !healed->report.mesh.closed) {
-            print_error(o->input + ": the mesh is open (" +
-                        std::to_string(healed->report.mesh.boundary_loops) +
-                        " boundary loops): no solid, nothing written (--require-solid)");
-            ctx.exit_code = kExitNoResult;
-            return;
-        }
         ReverseOptions ro;
         ro.method = o->method;
         ro.schema = o->schema;
@@ -128,6 +123,7 @@ void add_reverse(CLI::App& app, Context& ctx) {
         ro.product_name = in.stem().string();
         ro.progress = progress;
         ro.colors = !o->no_colors;
+        ro.require_solid = o->require_solid;
         ro.segment.tolerance = o->tolerance;
         ro.segment.surfaces = healed->surfaces;
         ro.segment.tools = healed->tools;

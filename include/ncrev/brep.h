@@ -58,6 +58,9 @@ struct ReverseOptions {
     bool colors = true;
     /// Measure the deviation between the solid and the mesh (ReverseReport::deviation).
     bool measure_deviation = true;
+    /// Write nothing (a warning says why) unless the result is solids: an open mesh with the
+    /// planar methods, or with auto / surfaces when its closed components are not most of it.
+    bool require_solid = false;
     ProgressFn progress;  ///< one call at the start and end of each stage
 };
 
@@ -107,6 +110,9 @@ struct ReverseReport {
     /// Cavities: closed shells inside a body (healing faces them into the cavity), each a void
     /// of the body's solid (written as a BREP_WITH_VOIDS).
     std::uint64_t voids = 0;
+    /// auto / surfaces on an open mesh whose closed components are most of it: the facets of
+    /// its open components (stray facets, scraps), left out of the solids (a warning says so).
+    std::uint64_t left_out_facets = 0;
     bool valid = false;         ///< the structural check (and BRepCheck_Analyzer) found no defect
     bool occt_checked = false;  ///< BRepCheck_Analyzer ran too (B-reps of up to 5000 faces)
     double solid_volume = 0, solid_area = 0;  ///< of the B-rep's faces

@@ -124,6 +124,8 @@ class Mesh {
 
    private:
     friend class MeshBuilder;
+    friend Mesh keep_components(const Mesh& mesh, std::span<const std::uint32_t> component,
+                                std::span<const std::uint8_t> keep);
     std::vector<Vec3> position_;
     std::vector<std::uint32_t> origin_;
     std::vector<std::uint32_t> twin_;
@@ -213,6 +215,13 @@ MeshStats compute_stats(const Mesh& mesh);
 /// Each facet's component: facets joined across shared edges, numbered from 0 in the order of
 /// their first facet (MeshStats::components of them).
 std::vector<std::uint32_t> face_components(const Mesh& mesh);
+
+/// The faces of `mesh` whose component (`component[f]`, as face_components() numbers them) is
+/// kept (`keep[component]` nonzero), as a mesh of its own. Whole components, so every half-edge
+/// keeps its twin and every vertex its fan. Vertices and faces keep their order; each face its
+/// source face (input_labels() still names the input facets) and its SRE attributes.
+Mesh keep_components(const Mesh& mesh, std::span<const std::uint32_t> component,
+                     std::span<const std::uint8_t> keep);
 
 /// How the closed components of a mesh lie in one another: a cavity's shell inside its part,
 /// an island in the cavity inside both.

@@ -8,6 +8,7 @@
 #include <Standard_Failure.hxx>
 #include <TopExp.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -705,6 +706,37 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
     }
 }
 
+/// An open mesh's closed components, when they are the part: they hold more than half of its
+/// area (kPartShare), the open ones then being stray facets or scraps that bound nothing. A
+/// mesh whose open components hold most of it (an open part, a sheet) has none: it is built
+/// with the planar method as a whole.
+struct ClosedPart {
+    std::vector<std::uint32_t> component;  ///< per face of the whole mesh
+    std::vector<std::uint8_t> kept;        ///< per component: closed
+    Mesh mesh;                             ///< the closed components
+};
+constexpr double kPartShare = 0.5;
+
+std::optional<ClosedPart> closed_part(const Mesh& mesh) {
+    ClosedPart part;
+    part.component = face_components(mesh);
+    const std::uint32_t count = *std::max_element(part.component.begin(), part.component.end()) + 1;
+    part.kept.assign(count, 1);
+    for (std::size_t h = 0; h < mesh.num_halfedges(); ++h) {
+        if (!mesh.twin(HalfedgeId(static_cast<std::uint32_t>(h))).is_valid())
+            part.kept[part.component[h / 3]] = 0;
+    }
+    double closed_area = 0, area = 0;
+    for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
+        const double a = mesh.face_area(FaceId(f));
+        area += a;
+        if (part.kept[part.component[f]]) closed_area += a;
+    }
+    if (closed_area <= kPartShare * area) return std::nullopt;
+    part.mesh = keep_components(mesh, part.component, part.kept);
+    return part;
+}
+
 }  // namespace
 
 Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::path& output,
@@ -725,6 +757,40 @@ Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::p
     const bool surfaces =
         options.method == ReverseMethod::kAuto || options.method == ReverseMethod::kSurfaces;
     if (surfaces && stats.closed) return reverse_surfaces(mesh, stats, output, options, rep);
+    if (surfaces) {
+        if (auto part = closed_part(mesh)) {
+            const MeshStats part_stats = compute_stats(part->mesh);
+            rep.mesh_volume = part_stats.volume;
+            rep.mesh_area = part_stats.area;
+            rep.left_out_facets = mesh.num_faces() - part->mesh.num_faces();
+            char share[32];
+            std::snprintf(share, sizeof share, "%.3g", 100 * (1 - part_stats.area / stats.area));
+            const std::uint64_t open = stats.components - part_stats.components;
+            rep.warnings.push_back(
+                std::to_string(open) + (open > 1 ? " open components" : " open component") +
+                " of the mesh (" + std::to_string(rep.left_out_facets) +
+                (rep.left_out_facets > 1 ? " facets, " : " facet, ") + share +
+                " % of its area) left out: they bound no solid (stray facets, scraps); the closed "
+                "ones are built (--method planar keeps every facet)");
+            auto out = reverse_surfaces(part->mesh, part_stats, output, options, rep);
+            if (out && out->segmentation) {
+                // The regions of the whole mesh's faces: -1 for those left out.
+                FaceMap<std::int32_t> region(mesh.num_faces(), -1);
+                std::uint32_t k = 0;
+                for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
+                    if (part->kept[part->component[f]])
+                        region[FaceId(f)] = out->segmentation->region[FaceId(k++)];
+                }
+                out->segmentation->region = std::move(region);
+            }
+            return out;
+        }
+    }
+    if (options.require_solid && !stats.closed) {
+        rep.warnings.push_back("the mesh is open (" + std::to_string(stats.boundary_loops) +
+                               " boundary loops): no solid, nothing written (required)");
+        return rep;
+    }
     if (surfaces) {
         rep.warnings.push_back(
             "the mesh is open: its surfaces cannot bound a solid, so it is built with the planar "

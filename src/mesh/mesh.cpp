@@ -106,6 +106,46 @@ std::vector<std::uint32_t> face_components(const Mesh& mesh) {
     return comp;
 }
 
+Mesh keep_components(const Mesh& mesh, std::span<const std::uint32_t> component,
+                     std::span<const std::uint8_t> keep) {
+    constexpr std::uint32_t kNone = HalfedgeId::kInvalid;
+    const std::size_t nf = mesh.num_faces(), nv = mesh.num_vertices();
+    std::vector<std::uint32_t> face_to(nf, kNone), vertex_to(nv, kNone);
+    std::uint32_t faces = 0, vertices = 0;
+    for (std::size_t f = 0; f < nf; ++f) {
+        if (!keep[component[f]]) continue;
+        face_to[f] = faces++;
+        for (int i = 0; i < 3; ++i) vertex_to[mesh.origin_[3 * f + i]] = 0;
+    }
+    Mesh out;
+    for (std::size_t v = 0; v < nv; ++v) {
+        if (vertex_to[v] == kNone) continue;
+        vertex_to[v] = vertices++;
+        out.position_.push_back(mesh.position_[v]);
+    }
+    const auto halfedge_to = [&](std::uint32_t h) {
+        return h == kNone ? kNone : 3 * face_to[h / 3] + h % 3;
+    };
+    out.origin_.reserve(3 * std::size_t{faces});
+    out.twin_.reserve(3 * std::size_t{faces});
+    for (std::size_t f = 0; f < nf; ++f) {
+        if (face_to[f] == kNone) continue;
+        for (std::size_t h = 3 * f; h < 3 * f + 3; ++h) {
+            out.origin_.push_back(vertex_to[mesh.origin_[h]]);
+            out.twin_.push_back(halfedge_to(mesh.twin_[h]));
+        }
+        out.source_face_.push_back(mesh.source_face_[f]);
+        if (!mesh.color_.empty()) out.color_.push_back(mesh.color_[f]);
+        if (!mesh.cut_.empty()) out.cut_.push_back(mesh.cut_[f]);
+        if (!mesh.surface_.empty()) out.surface_.push_back(mesh.surface_[f]);
+    }
+    out.outgoing_.resize(vertices);
+    for (std::size_t v = 0; v < nv; ++v) {
+        if (vertex_to[v] != kNone) out.outgoing_[vertex_to[v]] = halfedge_to(mesh.outgoing_[v]);
+    }
+    return out;
+}
+
 ComponentNesting component_nesting(const Mesh& mesh) {
     ComponentNesting out;
     out.component = face_components(mesh);

@@ -184,6 +184,7 @@ std::string to_json(const InfoReport& info, const ReverseReport& rev, int indent
                     {"solid", rev.solid},
                     {"bodies", rev.bodies},
                     {"voids", rev.voids},
+                    {"left_out_facets", rev.left_out_facets},
                     {"valid", rev.valid},
                     {"occt_checked", rev.occt_checked},
                     {"closed_valid_solid", rev.solid && rev.valid},
