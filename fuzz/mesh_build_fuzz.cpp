@@ -1,6 +1,6 @@
 // Fuzz target: mesh building and healing on arbitrary facet soups (coordinates from a small
 // lattice so that welds, duplicates, non-manifold edges and vertices are frequent). The mesh
-// must always satisfy its invariants.
+// must always satisfy its invariants, and the components' nesting stay within its components.
 #include <cstdlib>
 #include <cstring>
 
@@ -26,5 +26,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!r->mesh.validate().empty()) std::abort();
     const auto stats = ncrev::compute_stats(r->mesh);
     if (stats.faces != r->mesh.num_faces()) std::abort();
+    // Which closed component lies inside which (healing used the same to orient cavities).
+    const auto nesting = ncrev::component_nesting(r->mesh);
+    if (nesting.parent.size() != stats.components || nesting.depth.size() != stats.components)
+        std::abort();
+    for (std::size_t c = 0; c < nesting.parent.size(); ++c) {
+        const std::uint32_t p = nesting.parent[c];
+        if (p != ncrev::ComponentNesting::kNone && (p >= stats.components || p == c)) std::abort();
+        if ((p == ncrev::ComponentNesting::kNone) != (nesting.depth[c] == 0)) std::abort();
+    }
     return 0;
 }

@@ -164,6 +164,27 @@ TEST(MeshBuild, TurnsACavitysShellIntoTheCavity) {
     EXPECT_EQ(build_ok(balls(0, {false, false, false}), keep).heal.cavities, 0u);
 }
 
+// Two parts that cross (meshes overlapping without a union): a bar inside the ball's box that
+// pokes out of the ball at the top is no cavity, though most of its vertices are in the ball.
+TEST(MeshBuild, APartPokingThroughAnotherIsNoCavity) {
+    const test::Indexed ball = test::icosphere(5.0, 3, {5, 5, 5});
+    double top = 0;
+    for (const Vec3& p : ball.points) top = std::max(top, p.z);
+    // The bar's top corners, at x, y = 4 or 6, are out of the ball above z 5 + sqrt(23), and
+    // the bar's box stays in the ball's (else it is not even a candidate).
+    top -= 0.01;
+    ASSERT_GT(top, 5 + std::sqrt(23.0) + 0.05);
+    test::Indexed bar = test::cube();
+    for (Vec3& p : bar.points) p = Vec3{4, 4, 4} + Vec3{2 * p.x, 2 * p.y, (top - 4) * p.z};
+    test::Indexed inside = bar;
+    for (Vec3& p : inside.points) p.z = 4 + (p.z - 4) * 0.5;  // in the ball
+    for (const bool pokes : {true, false}) {
+        const BuildResult b = build_ok(test::to_bucket(test::merge(ball, pokes ? bar : inside)));
+        EXPECT_EQ(b.heal.cavities, pokes ? 0u : 1u) << pokes;
+        EXPECT_EQ(component_nesting(b.mesh).depth[1], pokes ? 0u : 1u) << pokes;
+    }
+}
+
 // A mesh of some of the components: valid on its own, each face with its input facet.
 TEST(MeshBuild, KeepsWholeComponentsAsAMeshOfTheirOwn) {
     test::Indexed m = test::merge(test::cube({0, 0, 0}, 1.0), test::icosphere(1.0, 1, {5, 0, 0}));

@@ -236,9 +236,10 @@ struct ComponentNesting {
     bool complete = true;
 };
 
-/// Which closed component lies inside which, by the parity of ray crossings from one vertex
-/// (three rays, the majority), tested only where one's box lies in the other's. Open
-/// components are neither inside nor around anything.
+/// Which closed component lies inside which, by the parity of ray crossings from its extreme
+/// vertices (three rays each, the majority; all six inside, so that two parts that cross are
+/// not nested), tested only where one's box lies in the other's. Open components are neither
+/// inside nor around anything.
 ComponentNesting component_nesting(const Mesh& mesh);
 
 /// Signed dihedral angle at the edge of `h`, in radians, in [-pi, pi]: the angle between the

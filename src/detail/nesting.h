@@ -14,7 +14,7 @@ namespace ncrev::detail {
 
 /// Ray-triangle tests and box comparisons nest_components() makes at most, a bound on its
 /// work: thousands of small loose components in one box would otherwise cost components x
-/// facets. About a second on this project's machines.
+/// facets.
 inline constexpr std::uint64_t kNestingWork = 300'000'000;
 
 inline constexpr std::uint32_t kNotNested = 0xffffffffu;
@@ -30,11 +30,13 @@ struct Nesting {
 
 /// `component[f]`: facet f's component (< `count`); `closed[c]`: component c has no boundary
 /// edge (only closed components have an inside); `corners(f)`: facet f's three points. Open
-/// components are never nested nor around anything. Component a lies inside b when a ray
-/// from a vertex of a crosses b's facets an odd number of times, for the majority of three
-/// rays (a ray that grazes an edge may count it twice or not at all), tested only where a's
-/// box lies in b's. Components do not cross one another (healing would have joined them), so
-/// one vertex tells. Deterministic; O(facets) when no box lies in another.
+/// components are never nested nor around anything. Component a lies inside b when rays from
+/// its extreme vertices (least and greatest x, y, z) cross b's facets an odd number of times,
+/// each by the majority of three rays (a ray that grazes an edge may count it twice or not at
+/// all), tested only where a's box lies in b's. All six must be inside: two parts that cross
+/// (meshes overlapping without a union, which healing does not join) are not nested, and
+/// where one pokes through the other an extreme vertex is usually what pokes out.
+/// Deterministic; O(facets) when no box lies in another.
 template <class Corners>
 Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t count,
                         std::span<const std::uint8_t> closed, const Corners& corners) {
@@ -45,12 +47,19 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
     for (std::uint32_t c = 0; c < count; ++c) num_closed += closed[c] != 0;
     if (num_closed < 2) return out;
     std::vector<Box3> box(count);
-    std::vector<std::uint32_t> first(count, kNotNested);  // a facet of each
+    // Per component, its vertices of least and greatest x, y and z (the first met).
+    std::vector<std::array<Vec3, 6>> extreme(count);
     for (std::uint32_t f = 0; f < component.size(); ++f) {
         const std::uint32_t c = component[f];
         if (!closed[c]) continue;
-        if (first[c] == kNotNested) first[c] = f;
-        for (const Vec3& p : corners(f)) box[c].add(p);
+        for (const Vec3& p : corners(f)) {
+            const bool fresh = box[c].empty();
+            for (int axis = 0; axis < 3; ++axis) {
+                if (fresh || p[axis] < box[c].min[axis]) extreme[c][2 * axis] = p;
+                if (fresh || p[axis] > box[c].max[axis]) extreme[c][2 * axis + 1] = p;
+            }
+            box[c].add(p);
+        }
     }
     const auto inside_box = [](const Box3& a, const Box3& b) {
         return a.min.x >= b.min.x && a.min.y >= b.min.y && a.min.z >= b.min.z &&
@@ -90,35 +99,39 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
     for (std::uint32_t a = 0; a < count; ++a) {
         for (std::uint32_t b = 0; b < count && closed[a]; ++b) {
             if (!candidate(a, b)) continue;
-            work += rays.size() * facets[b].size();
+            work += extreme[a].size() * rays.size() * facets[b].size();
             if (work > kNestingWork) {
                 out.complete = false;
                 out.parent.assign(count, kNotNested);
                 out.depth.assign(count, 0);
                 return out;
             }
-            const Vec3 o = corners(first[a])[0];
-            int odd = 0;
-            for (const Vec3& d : rays) {
-                std::uint64_t hits = 0;
-                for (const std::uint32_t f : facets[b]) {
-                    const std::array<Vec3, 3> t = corners(f);
-                    const Vec3 e1 = t[1] - t[0];
-                    const Vec3 e2 = t[2] - t[0];
-                    const Vec3 q = cross(d, e2);
-                    const double det = dot(e1, q);
-                    if (det == 0) continue;
-                    const Vec3 s = o - t[0];
-                    const double u = dot(s, q) / det;
-                    if (u < 0 || u > 1) continue;
-                    const Vec3 r = cross(s, e1);
-                    const double v = dot(d, r) / det;
-                    if (v < 0 || u + v > 1) continue;
-                    if (dot(e2, r) / det > 0) ++hits;
+            bool inside = true;
+            for (std::size_t e = 0; e < extreme[a].size() && inside; ++e) {
+                const Vec3 o = extreme[a][e];
+                int odd = 0;
+                for (const Vec3& d : rays) {
+                    std::uint64_t hits = 0;
+                    for (const std::uint32_t f : facets[b]) {
+                        const std::array<Vec3, 3> t = corners(f);
+                        const Vec3 e1 = t[1] - t[0];
+                        const Vec3 e2 = t[2] - t[0];
+                        const Vec3 q = cross(d, e2);
+                        const double det = dot(e1, q);
+                        if (det == 0) continue;
+                        const Vec3 s = o - t[0];
+                        const double u = dot(s, q) / det;
+                        if (u < 0 || u > 1) continue;
+                        const Vec3 r = cross(s, e1);
+                        const double v = dot(d, r) / det;
+                        if (v < 0 || u + v > 1) continue;
+                        if (dot(e2, r) / det > 0) ++hits;
+                    }
+                    odd += static_cast<int>(hits % 2);
                 }
-                odd += static_cast<int>(hits % 2);
+                inside = 2 * odd > static_cast<int>(rays.size());
             }
-            if (2 * odd > static_cast<int>(rays.size())) around[a].push_back(b);
+            if (inside) around[a].push_back(b);
         }
     }
     // The innermost of the components around a is the one with most around it.
