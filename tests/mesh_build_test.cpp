@@ -185,6 +185,24 @@ TEST(MeshBuild, APartPokingThroughAnotherIsNoCavity) {
     }
 }
 
+// Too many components to tell which lies inside which within kNestingWork (a ball of 20k
+// facets round a thousand small cubes, each to be tested against it): no ray is cast, every
+// closed component is turned outward, and the report says the check was not made.
+TEST(MeshBuild, TooManyComponentsToNestAreAllTurnedOutward) {
+    test::Indexed m = test::icosphere(50.0, 5);
+    for (int k = 0; k < 1000; ++k) {
+        const Vec3 o{-10.0 + 2 * (k % 10), -10.0 + 2 * ((k / 10) % 10), -10.0 + 2 * (k / 100)};
+        test::Indexed cube = test::cube(o, 1.0);
+        for (auto& t : cube.triangles) std::swap(t[1], t[2]);  // given as cavities would be
+        m = test::merge(m, cube);
+    }
+    const BuildResult b = build_ok(test::to_indexed_soup(m));
+    EXPECT_TRUE(b.heal.nesting_unchecked);
+    EXPECT_EQ(b.heal.cavities, 0u);
+    EXPECT_EQ(b.heal.components_turned_outward, 1000u);
+    EXPECT_FALSE(component_nesting(b.mesh).complete);
+}
+
 // A mesh of some of the components: valid on its own, each face with its input facet.
 TEST(MeshBuild, KeepsWholeComponentsAsAMeshOfTheirOwn) {
     test::Indexed m = test::merge(test::cube({0, 0, 0}, 1.0), test::icosphere(1.0, 1, {5, 0, 0}));

@@ -3,6 +3,7 @@
 // the cavity) and by the B-rep builders (a cavity is a void of its part's solid).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -49,9 +50,11 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
     std::vector<Box3> box(count);
     // Per component, its vertices of least and greatest x, y and z (the first met).
     std::vector<std::array<Vec3, 6>> extreme(count);
+    std::vector<std::uint64_t> size(count, 0);
     for (std::uint32_t f = 0; f < component.size(); ++f) {
         const std::uint32_t c = component[f];
         if (!closed[c]) continue;
+        ++size[c];
         for (const Vec3& p : corners(f)) {
             const bool fresh = box[c].empty();
             for (int axis = 0; axis < 3; ++axis) {
@@ -68,44 +71,37 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
     const auto candidate = [&](std::uint32_t a, std::uint32_t b) {
         return a != b && closed[a] && closed[b] && inside_box(box[a], box[b]);
     };
-    // The pairs are found twice (here, then tested below) rather than stored: concentric
-    // shells by the thousand would make millions of them.
-    std::uint64_t work = 0;
-    std::vector<std::uint8_t> is_outer(count, 0);
-    bool any = false;
-    for (std::uint32_t a = 0; a < count; ++a) {
-        if (!closed[a]) continue;
-        work += count;
-        if (work > kNestingWork) {
-            out.complete = false;
-            return out;
-        }
-        for (std::uint32_t b = 0; b < count; ++b) {
-            if (!candidate(a, b)) continue;
-            is_outer[b] = 1;
-            any = true;
-        }
-    }
-    if (!any) return out;
-    std::vector<std::vector<std::uint32_t>> facets(count);
-    for (std::uint32_t f = 0; f < component.size(); ++f) {
-        if (is_outer[component[f]]) facets[component[f]].push_back(f);
-    }
     // Directions no mesh of a machined part lines up with.
     const std::array<Vec3, 3> rays{normalized(Vec3{0.5773, 0.4082, 0.7071}),
                                    normalized(Vec3{-0.3162, 0.8944, 0.3169}),
                                    normalized(Vec3{0.6325, -0.2236, -0.7416})};
+    // The pairs are found twice (here, then tested below) rather than stored: concentric
+    // shells by the thousand would make millions of them. Their whole work is counted before
+    // any ray is cast, so that a check too large to finish costs no more than this count.
+    std::uint64_t work = 0;
+    std::vector<std::uint8_t> is_outer(count, 0);
+    for (std::uint32_t a = 0; a < count; ++a) {
+        if (!closed[a]) continue;
+        work += count;
+        for (std::uint32_t b = 0; b < count && work <= kNestingWork; ++b) {
+            if (!candidate(a, b)) continue;
+            is_outer[b] = 1;
+            work += extreme[a].size() * rays.size() * size[b];
+        }
+        if (work > kNestingWork) {
+            out.complete = false;
+            return out;
+        }
+    }
+    if (std::find(is_outer.begin(), is_outer.end(), 1) == is_outer.end()) return out;
+    std::vector<std::vector<std::uint32_t>> facets(count);
+    for (std::uint32_t f = 0; f < component.size(); ++f) {
+        if (is_outer[component[f]]) facets[component[f]].push_back(f);
+    }
     std::vector<std::vector<std::uint32_t>> around(count);
     for (std::uint32_t a = 0; a < count; ++a) {
         for (std::uint32_t b = 0; b < count && closed[a]; ++b) {
             if (!candidate(a, b)) continue;
-            work += extreme[a].size() * rays.size() * facets[b].size();
-            if (work > kNestingWork) {
-                out.complete = false;
-                out.parent.assign(count, kNotNested);
-                out.depth.assign(count, 0);
-                return out;
-            }
             bool inside = true;
             for (std::size_t e = 0; e < extreme[a].size() && inside; ++e) {
                 const Vec3 o = extreme[a][e];
