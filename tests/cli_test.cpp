@@ -118,6 +118,27 @@ TEST(CliInfo, ACavityIsCountedAndItsVolumeIsNotMaterial) {
     std::filesystem::remove(path);
 }
 
+// A ball that lost a facet: healing fills the hole and says so; --keep-holes shows it open.
+TEST(CliInfo, FillsASmallHoleUnlessToldToKeepIt) {
+    auto m = test::icosphere(10.0, 3);
+    m.triangles.erase(m.triangles.begin() + 7);
+    const auto path = write_temp("ncrev_cli_hole.stl", encode_stl_binary(m.points, m.triangles));
+    const CliRun filled = run("info --json " + path.string());
+    ASSERT_EQ(filled.code, 0) << filled.err;
+    const auto j = nlohmann::json::parse(filled.out);
+    EXPECT_EQ(j["healing"]["holes_filled"], 1);
+    EXPECT_EQ(j["healing"]["hole_facets_added"], 1);
+    EXPECT_EQ(j["mesh"]["closed"], true);
+    EXPECT_EQ(j["mesh"]["facets"], m.triangles.size() + 1);
+    const CliRun kept = run("info --json --keep-holes " + path.string());
+    ASSERT_EQ(kept.code, 0) << kept.err;
+    const auto k = nlohmann::json::parse(kept.out);
+    EXPECT_EQ(k["healing"]["holes_filled"], 0);
+    EXPECT_EQ(k["mesh"]["closed"], false);
+    EXPECT_EQ(k["mesh"]["boundary_loops"], 1);
+    std::filesystem::remove(path);
+}
+
 TEST(CliInfo, BadInputExitsTwoWithFileAndPlaceAndNoStdout) {
     const auto path =
         write_temp("ncrev_cli_bad.stl", test::bytes_of("solid x\nfacet normal 0 0 1\nouter lop\n"));
@@ -251,7 +272,7 @@ TEST(CliReverse, RefusesAFolderForAnOutputAndNamesBadNumbersPlainly) {
 
 TEST(CliReverse, OpenMeshWithRequireSolidExitsThreeAndWritesNothing) {
     auto c = test::cube({0, 0, 0}, 10.0);
-    c.triangles.pop_back();
+    c.triangles.resize(c.triangles.size() - 2);  // an open box: no hole healing fills
     const auto stl = write_temp("ncrev_cli_rev_open.stl", encode_stl_binary(c.points, c.triangles));
     const auto step = test::scratch_dir() / "ncrev_cli_rev_open.step";
     std::filesystem::remove(step);
@@ -317,7 +338,7 @@ TEST(CliReverse, AutoGivesTheTrueFacesWithLabelsSegmentsAndReport) {
     for (const auto& p : {step, labels, ply}) std::filesystem::remove(p);
 
     auto c = test::cube({0, 0, 0}, 10.0);
-    c.triangles.pop_back();
+    c.triangles.resize(c.triangles.size() - 2);  // an open box: no hole healing fills
     const auto open =
         write_temp("ncrev_cli_surfaces_open.stl", encode_stl_binary(c.points, c.triangles));
     const CliRun s =

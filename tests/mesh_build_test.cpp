@@ -203,12 +203,88 @@ TEST(MeshBuild, TooManyComponentsToNestAreAllTurnedOutward) {
     EXPECT_FALSE(component_nesting(b.mesh).complete);
 }
 
+// A cube whose top is a 4 x 4 grid while its sides are two facets each, as a CAD system
+// tessellating faces apart writes it: three top vertices lie in the middle of each side's top
+// edge (T-junctions), four cracks of no area. Closed by splitting the sides' facets there.
+TEST(MeshBuild, ClosesCracksAlongTJunctions) {
+    test::Indexed m = test::cube({0, 0, 0}, 4.0);
+    // Drop the top's two facets (those with all vertices at z = 4) for a grid.
+    std::erase_if(m.triangles, [&](const test::Tri& t) {
+        return m.points[t[0]].z == 4 && m.points[t[1]].z == 4 && m.points[t[2]].z == 4;
+    });
+    const auto base = static_cast<std::uint32_t>(m.points.size());
+    for (int j = 0; j <= 4; ++j) {
+        for (int i = 0; i <= 4; ++i) m.points.push_back({double(i), double(j), 4.0});
+    }
+    const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(5 * j + i); };
+    for (int j = 0; j < 4; ++j) {
+        for (int i = 0; i < 4; ++i) {
+            m.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+            m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+    }
+    for (const bool fill : {false, true}) {
+        HealOptions o;
+        o.fill_holes = fill;
+        const BuildResult b = build_ok(test::to_bucket(m), o);
+        const MeshStats s = compute_stats(b.mesh);
+        EXPECT_EQ(b.mesh.validate(), "");
+        EXPECT_EQ(s.closed, fill);
+        EXPECT_EQ(b.heal.facets_split_at_t_junctions, fill ? 4u : 0u);
+        EXPECT_EQ(b.heal.holes_filled, 0u);
+        if (fill) {
+            EXPECT_EQ(s.euler_characteristic, 2);
+            EXPECT_DOUBLE_EQ(s.volume, 64.0);
+            // Every face still names its input facet (split ones both theirs).
+            for (const std::uint32_t f : b.mesh.source_faces()) EXPECT_LT(f, m.triangles.size());
+        }
+    }
+}
+
+// A ball that lost a facet, and one that lost the six round a vertex: small holes in a closed
+// part, filled. A hemisphere's rim and a loose facet are openings, not holes: left open.
+TEST(MeshBuild, FillsSmallHolesButNotOpenings) {
+    const test::Indexed ball = test::icosphere(10.0, 3);
+    const MeshStats whole = compute_stats(build_ok(test::to_bucket(ball)).mesh);
+    test::Indexed one = ball;
+    one.triangles.erase(one.triangles.begin() + 100);
+    test::Indexed six = ball;
+    const std::uint32_t v = six.triangles[200][0];
+    std::erase_if(six.triangles,
+                  [&](const test::Tri& t) { return t[0] == v || t[1] == v || t[2] == v; });
+    ASSERT_EQ(six.triangles.size() + 6, ball.triangles.size());
+    for (const auto& [holed, added] : {std::pair{one, 1u}, std::pair{six, 4u}}) {
+        const BuildResult b = build_ok(test::to_bucket(holed));
+        const MeshStats s = compute_stats(b.mesh);
+        EXPECT_EQ(b.mesh.validate(), "");
+        EXPECT_TRUE(s.closed);
+        EXPECT_EQ(b.heal.holes_filled, 1u);
+        EXPECT_EQ(b.heal.hole_facets_added, added);
+        EXPECT_EQ(b.mesh.num_faces(), holed.triangles.size() + added);
+        EXPECT_NEAR(s.volume, whole.volume, 1e-3 * whole.volume);
+        // The added facets name no input facet.
+        std::size_t unnamed = 0;
+        for (const std::uint32_t f : b.mesh.source_faces()) unnamed += f >= holed.triangles.size();
+        EXPECT_EQ(unnamed, added);
+    }
+    test::Indexed half = ball;
+    std::erase_if(half.triangles, [&](const test::Tri& t) {
+        return half.points[t[0]].z + half.points[t[1]].z + half.points[t[2]].z < 0;
+    });
+    half = test::merge(half, test::Indexed{{{30, 0, 0}, {31, 0, 0}, {30, 1, 0}}, {{0, 1, 2}}});
+    const BuildResult b = build_ok(test::to_bucket(half));
+    EXPECT_EQ(b.heal.holes_filled, 0u);
+    EXPECT_EQ(compute_stats(b.mesh).boundary_loops, 2u);
+}
+
 // A mesh of some of the components: valid on its own, each face with its input facet.
 TEST(MeshBuild, KeepsWholeComponentsAsAMeshOfTheirOwn) {
     test::Indexed m = test::merge(test::cube({0, 0, 0}, 1.0), test::icosphere(1.0, 1, {5, 0, 0}));
     m = test::merge(m, test::cube({9, 0, 0}, 1.0));
     m.triangles.erase(m.triangles.begin() + 12);  // the ball is open now
-    const BuildResult b = build_ok(test::to_indexed_soup(m));
+    HealOptions keep_open;
+    keep_open.fill_holes = false;
+    const BuildResult b = build_ok(test::to_indexed_soup(m), keep_open);
     const std::vector<std::uint32_t> comp = face_components(b.mesh);
     std::vector<std::uint8_t> keep = {1, 0, 1};
     const Mesh cubes = keep_components(b.mesh, comp, keep);
@@ -299,7 +375,9 @@ TEST(MeshBuild, FindsHolesAsBoundaryLoops) {
     auto m2 = test::cube();
     m2.triangles.erase(m2.triangles.begin() + 2);  // one top triangle (vertices 4 5 6)
     m2.triangles.erase(m2.triangles.begin());      // one bottom triangle (0 2 1): no shared vertex
-    auto b2 = build_ok(test::to_bucket(m2));
+    HealOptions keep_open;                         // else each, one missing facet, is filled
+    keep_open.fill_holes = false;
+    auto b2 = build_ok(test::to_bucket(m2), keep_open);
     const MeshStats s2 = compute_stats(b2.mesh);
     EXPECT_EQ(s2.boundary_loops, 2u);
     EXPECT_EQ(s2.boundary_edges, 6u);

@@ -13,6 +13,7 @@ struct InfoOptions {
     bool json = false;
     bool quiet = false;
     double tolerance = -1;
+    bool keep_holes = false;
 };
 
 void add_info(CLI::App& app, Context& ctx) {
@@ -30,11 +31,16 @@ void add_info(CLI::App& app, Context& ctx) {
                     "Weld distance in model units (default: 1e-6 x bounding-box diagonal, at "
                     "least 8 float32 ulps of the largest coordinate; 0: exact weld only)")
         ->check(kNonNegative);
+    cmd->add_flag("--keep-holes", opts->keep_holes,
+                  "Leave the mesh's holes open: by default cracks along T-junctions are closed by "
+                  "splitting facets, and small holes (up to 64 edges, a perimeter up to half the "
+                  "part's size) get new facets");
     cmd->add_flag("-q,--quiet", opts->quiet,
                   "No warnings and no progress on stderr (progress is only shown on a terminal)");
     cmd->callback([opts, &ctx]() {
         HealOptions heal;
         heal.weld_tolerance = opts->tolerance;
+        heal.fill_holes = !opts->keep_holes;
         auto report = inspect_file(opts->path, heal, terminal_progress(ctx, opts->quiet));
         if (!report) {
             print_error(report.error().describe());

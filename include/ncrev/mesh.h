@@ -143,6 +143,10 @@ struct HealOptions {
     double weld_tolerance = -1.0;
     /// Orient facets consistently, turn closed components outward and cavities' shells inward.
     bool orient = true;
+    /// Close small holes: a boundary loop of a few edges, short beside its part (missing facets,
+    /// a crack along a T-junction), gets facets of its own (docs/healing.md). Deliberate
+    /// openings, a sheet's border, a loose facet are left open.
+    bool fill_holes = true;
 };
 
 /// What healing found and did, in numbers. Counts refer to the input facets / points.
@@ -172,6 +176,11 @@ struct HealReport {
     std::uint64_t nonmanifold_vertices = 0;  ///< vertices with more than one fan (then split)
     std::uint64_t orientation_conflicts =
         0;  ///< edges cut to make a non-orientable part orientable
+    /// Facets split at the vertices lying in the middle of their open edges (T-junctions: the
+    /// crack between faces tessellated apart), closing the crack (fill_holes).
+    std::uint64_t facets_split_at_t_junctions = 0;
+    std::uint64_t holes_filled = 0;       ///< small holes closed with new facets (fill_holes)
+    std::uint64_t hole_facets_added = 0;  ///< facets added to close them
 };
 
 /// Numbers that describe a built mesh.

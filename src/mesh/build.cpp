@@ -13,7 +13,10 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cmath>
 #include <cstring>
+#include <limits>
+#include <map>
 #include <numeric>
 #include <unordered_map>
 
@@ -345,6 +348,12 @@ class MeshBuilder {
     /// reused or released as soon as they are no longer needed, to keep the peak low.
     static Result<BuildResult> build(const TriangleSoup& soup, TriangleSoup* owned,
                                      const HealOptions& options, const ProgressFn& progress);
+    static Result<BuildResult> fill_holes(BuildResult built, const HealOptions& options,
+                                          const ProgressFn& progress);
+    static Result<BuildResult> rebuild(
+        BuildResult built, const std::map<std::uint32_t, std::vector<std::uint32_t>>& split,
+        const std::vector<std::array<std::uint32_t, 3>>& added,
+        const std::vector<std::uint32_t>& added_next_to, const HealOptions& options);
 };
 
 Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* owned,
@@ -842,15 +851,330 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     return out;
 }
 
+namespace {
+
+// Hole filling. A file that lost a few facets has small boundary loops in an otherwise closed
+// part; a deliberate opening, a sheet's border, a loose facet's own edges are large beside
+// their component. A loop is filled when it is one missing facet (three edges), or has at most
+// kMaxHoleEdges edges and a perimeter at most kMaxHolePerimeter times its component's box
+// diagonal: a sheet's, a loose facet's or an open box's border is at least twice its diagonal
+// (a quarter of that is the bound); a missing facet's is a few facets' edges, a missing end of
+// a bar a small part of its length. And only when every loop of the component is, and the
+// component then bounds a volume (a sheet or a loose facet would close into a pillow of none).
+// The edge bound also keeps the ear clipping (quadratic in the edges) cheap. Before that, cracks
+// along T-junctions (a vertex of one face's tessellation in the middle of the neighbouring
+// face's edge) are closed whatever their length, by splitting the facets at the vertices on
+// their open edges (t_junctions()): that adds no surface.
+constexpr std::size_t kMaxHoleEdges = 64;
+constexpr double kMaxHolePerimeter = 0.5;
+
+/// Facets closing the loop `loop` (vertex ids in the order of its boundary half-edges), each
+/// running the loop's edges the other way, as a neighbour facet would: ear clipping in the
+/// plane of the loop's Newell normal. Empty when no ear is found (a loop that folds over
+/// itself in that plane) or the loop has no area.
+std::vector<std::array<std::uint32_t, 3>> close_loop(const Mesh& m,
+                                                     const std::vector<std::uint32_t>& loop) {
+    std::vector<std::array<std::uint32_t, 3>> out;
+    const std::size_t k = loop.size();
+    Vec3 n{}, c{};
+    for (std::size_t i = 0; i < k; ++i) c += m.position(VertexId(loop[i]));
+    c = c / static_cast<double>(k);
+    for (std::size_t i = 0; i < k; ++i) {
+        n += cross(m.position(VertexId(loop[i])) - c, m.position(VertexId(loop[(i + 1) % k])) - c);
+    }
+    if (norm(n) == 0) return out;
+    n = normalized(n);
+    const Vec3 u = normalized(cross(std::abs(n.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}, n));
+    const Vec3 v = cross(n, u);
+    struct P2 {
+        double x, y;
+    };
+    std::vector<P2> p(k);
+    for (std::size_t i = 0; i < k; ++i) {
+        const Vec3 q = m.position(VertexId(loop[i])) - c;
+        p[i] = {dot(q, u), dot(q, v)};
+    }
+    // The loop runs counter-clockwise about its Newell normal.
+    const auto turn = [&](std::size_t a, std::size_t b, std::size_t d) {
+        return (p[b].x - p[a].x) * (p[d].y - p[a].y) - (p[b].y - p[a].y) * (p[d].x - p[a].x);
+    };
+    std::vector<std::size_t> ring(k);
+    for (std::size_t i = 0; i < k; ++i) ring[i] = i;
+    while (ring.size() > 3) {
+        bool clipped = false;
+        for (std::size_t i = 0; i < ring.size() && !clipped; ++i) {
+            const std::size_t a = ring[(i + ring.size() - 1) % ring.size()], b = ring[i],
+                              d = ring[(i + 1) % ring.size()];
+            if (turn(a, b, d) <= 0) continue;
+            bool empty = true;
+            for (const std::size_t j : ring) {
+                if (j == a || j == b || j == d) continue;
+                if (turn(a, b, j) >= 0 && turn(b, d, j) >= 0 && turn(d, a, j) >= 0) {
+                    empty = false;
+                    break;
+                }
+            }
+            if (!empty) continue;
+            out.push_back({loop[a], loop[d], loop[b]});
+            ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(i));
+            clipped = true;
+        }
+        if (!clipped) return {};
+    }
+    out.push_back({loop[ring[0]], loop[ring[2]], loop[ring[1]]});
+    return out;
+}
+
+/// Boundary vertices strictly inside boundary edges, within `tol` of them (T-junctions: a
+/// vertex of one face's tessellation in the middle of the neighbouring face's edge), as the
+/// face to split and its vertices along that edge, in order: {half-edge, v1, v2 ...}. Each
+/// edge looks only at the vertices in its slab along the axis it spans least (sorted
+/// coordinates), so a mesh's boundary costs about its size. Faces with more than one such edge
+/// are left as they are (a fan would not do).
+std::map<std::uint32_t, std::vector<std::uint32_t>> t_junctions(const Mesh& m, double tol) {
+    std::map<std::uint32_t, std::vector<std::uint32_t>> out;
+    const std::size_t nh = m.num_halfedges();
+    std::vector<std::uint32_t> edges, vertices;
+    for (std::size_t h = 0; h < nh; ++h) {
+        if (m.twins()[h] != HalfedgeId::kInvalid) continue;
+        edges.push_back(static_cast<std::uint32_t>(h));
+        vertices.push_back(m.origins()[h]);
+    }
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    std::array<std::vector<std::pair<double, std::uint32_t>>, 3> by;  // per axis, sorted
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const std::uint32_t v : vertices)
+            by[axis].emplace_back(m.position(VertexId(v))[axis], v);
+        std::sort(by[axis].begin(), by[axis].end());
+    }
+    std::map<std::uint32_t, std::uint32_t> face_edge;
+    for (const std::uint32_t h : edges) {
+        const Vec3 p = m.position(m.origin(HalfedgeId(h))), q = m.position(m.target(HalfedgeId(h)));
+        const double len = norm(q - p);
+        if (len <= 2 * tol) continue;
+        int axis = 0;
+        for (int k = 1; k < 3; ++k) {
+            if (std::abs(q[k] - p[k]) < std::abs(q[axis] - p[axis])) axis = k;
+        }
+        const double lo = std::min(p[axis], q[axis]) - tol, hi = std::max(p[axis], q[axis]) + tol;
+        auto it =
+            std::lower_bound(by[axis].begin(), by[axis].end(), std::pair{lo, std::uint32_t{0}});
+        std::vector<std::pair<double, std::uint32_t>> inside;
+        for (; it != by[axis].end() && it->first <= hi; ++it) {
+            const Vec3 x = m.position(VertexId(it->second));
+            const double t = dot(x - p, q - p) / (len * len);
+            if (t * len <= tol || (1 - t) * len <= tol) continue;
+            if (norm(x - (p + t * (q - p))) > tol) continue;
+            inside.emplace_back(t, it->second);
+        }
+        if (inside.empty()) continue;
+        std::sort(inside.begin(), inside.end());
+        const std::uint32_t f = h / 3;
+        if (out.count(f)) {
+            face_edge[f] = HalfedgeId::kInvalid;  // a second edge: left alone
+            continue;
+        }
+        std::vector<std::uint32_t> split{h};
+        for (const auto& [t, v] : inside) split.push_back(v);
+        out.emplace(f, std::move(split));
+        face_edge[f] = h;
+    }
+    for (const auto& [f, h] : face_edge) {
+        if (h == HalfedgeId::kInvalid) out.erase(f);
+    }
+    return out;
+}
+
+}  // namespace
+
+/// `built`'s faces again, those in `split` split along one edge at the vertices on it, then the
+/// facets `added` (each beside face `added_next_to[k]`), built with the same options (holes
+/// and cracks aside): the faces keep their input facets, the added ones have none, and the
+/// report adds the second build's counts to the first's.
+Result<BuildResult> MeshBuilder::rebuild(
+    BuildResult built, const std::map<std::uint32_t, std::vector<std::uint32_t>>& split,
+    const std::vector<std::array<std::uint32_t, 3>>& added,
+    const std::vector<std::uint32_t>& added_next_to, const HealOptions& options) {
+    const Mesh& m = built.mesh;
+    const std::uint32_t nf = static_cast<std::uint32_t>(m.num_faces());
+    TriangleSoup soup;
+    soup.points.assign(m.positions().begin(), m.positions().end());
+    std::vector<std::uint32_t> from;  // per facet of `soup`, the face it comes from
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        const auto it = split.find(f);
+        if (it == split.end()) {
+            soup.triangles.push_back({m.vertex(FaceId(f), 0).idx(), m.vertex(FaceId(f), 1).idx(),
+                                      m.vertex(FaceId(f), 2).idx()});
+            from.push_back(f);
+            continue;
+        }
+        // (p, q, r) with p -> q the split edge: (p, s1, r), (s1, s2, r) ... (sk, q, r).
+        const HalfedgeId h(it->second.front());
+        const std::uint32_t q = m.target(h).idx(), r = m.origin(Mesh::prev(h)).idx();
+        std::uint32_t p = m.origin(h).idx();
+        for (std::size_t i = 1; i <= it->second.size(); ++i) {
+            const std::uint32_t s = i < it->second.size() ? it->second[i] : q;
+            soup.triangles.push_back({p, s, r});
+            from.push_back(f);
+            p = s;
+        }
+    }
+    const std::size_t own = soup.triangles.size();
+    soup.triangles.insert(soup.triangles.end(), added.begin(), added.end());
+    from.insert(from.end(), added_next_to.begin(), added_next_to.end());
+    if (m.has_attributes()) {
+        for (std::size_t k = 0; k < soup.triangles.size(); ++k) {
+            soup.color.push_back(m.colors()[from[k]]);  // an added facet: the tool beside it
+            soup.cut.push_back(k < own ? m.cuts()[from[k]] : -1);
+            soup.surface.push_back(k < own ? m.surfaces()[from[k]] : -1);  // added: none known
+        }
+    }
+    HealOptions again = options;
+    again.fill_holes = false;
+    again.weld_tolerance = built.heal.tolerance;
+    Result<BuildResult> rebuilt = build(soup, &soup, again, {});
+    if (!rebuilt.ok()) return rebuilt;
+    for (std::uint32_t& s : rebuilt->mesh.source_face_) {
+        s = s < own ? m.source_face_[from[s]] : std::numeric_limits<std::uint32_t>::max();
+    }
+    HealReport& heal = built.heal;
+    const HealReport& second = rebuilt->heal;
+    heal.degenerate_facets_removed += second.degenerate_facets_removed;
+    heal.caps_split += second.caps_split;
+    heal.duplicate_facets_removed += second.duplicate_facets_removed;
+    heal.flipped_facets += second.flipped_facets;
+    heal.nonmanifold_edges += second.nonmanifold_edges;
+    heal.nonmanifold_vertices += second.nonmanifold_vertices;
+    heal.orientation_conflicts += second.orientation_conflicts;
+    rebuilt->heal = std::move(heal);
+    return rebuilt;
+}
+
+/// Closes the cracks along T-junctions of `built` (faces split at the vertices across), then
+/// its small holes (kMaxHoleEdges, kMaxHolePerimeter) with new facets.
+Result<BuildResult> MeshBuilder::fill_holes(BuildResult built, const HealOptions& options,
+                                            const ProgressFn& progress) {
+    const auto open = [](const Mesh& m) {
+        for (const std::uint32_t t : m.twins()) {
+            if (t == HalfedgeId::kInvalid) return true;
+        }
+        return false;
+    };
+    if (!open(built.mesh)) return built;
+    if (progress) progress("fill holes", 0.0);
+    if (auto split = t_junctions(built.mesh, built.heal.tolerance); !split.empty()) {
+        const std::size_t cracked = split.size();
+        Result<BuildResult> r = rebuild(std::move(built), split, {}, {}, options);
+        if (!r.ok()) return r;
+        built = std::move(r).value();
+        built.heal.facets_split_at_t_junctions = cracked;
+        if (!open(built.mesh)) {
+            if (progress) progress("fill holes", 1.0);
+            return built;
+        }
+    }
+    const Mesh& m = built.mesh;
+    const std::size_t nh = m.num_halfedges(), nf = m.num_faces();
+    std::vector<std::array<std::uint32_t, 3>> added;
+    std::vector<std::uint32_t> added_next_to;  // a face beside each added facet's loop
+    const std::vector<std::uint32_t> comp = face_components(m);
+    std::vector<Box3> box;
+    for (std::size_t f = 0; f < nf; ++f) {
+        if (comp[f] >= box.size()) box.resize(comp[f] + 1);
+        for (int i = 0; i < 3; ++i)
+            box[comp[f]].add(m.position(m.vertex(FaceId(static_cast<std::uint32_t>(f)), i)));
+    }
+    // Per component: its loops that would be filled, and whether all of them would.
+    struct Fill {
+        std::vector<std::array<std::uint32_t, 3>> facets;
+        std::uint32_t next_to = 0;
+    };
+    std::vector<std::vector<Fill>> fills(box.size());
+    std::vector<std::uint8_t> all_filled(box.size(), 1);
+    std::vector<std::uint8_t> seen(nh, 0);
+    std::vector<std::uint32_t> loop;
+    for (std::size_t h0 = 0; h0 < nh; ++h0) {
+        if (seen[h0] || m.twins()[h0] != HalfedgeId::kInvalid) continue;
+        loop.clear();
+        double perimeter = 0;
+        HalfedgeId g(static_cast<std::uint32_t>(h0));
+        for (std::size_t guard = 0; guard <= nh && !seen[g.idx()]; ++guard) {
+            seen[g.idx()] = 1;
+            loop.push_back(m.origin(g).idx());
+            perimeter += norm(m.position(m.target(g)) - m.position(m.origin(g)));
+            g = m.outgoing(m.target(g));
+            if (!m.is_boundary(g)) break;  // cannot happen on a valid mesh
+        }
+        const std::uint32_t c = comp[h0 / 3];
+        // One missing facet (three edges), or a hole small beside its part.
+        const bool small = loop.size() == 3 || (loop.size() <= kMaxHoleEdges &&
+                                                perimeter <= kMaxHolePerimeter * box[c].diagonal());
+        auto facets = g.idx() == h0 && loop.size() >= 3 && small
+                          ? close_loop(m, loop)
+                          : std::vector<std::array<std::uint32_t, 3>>{};
+        if (facets.empty()) {
+            all_filled[c] = 0;
+            continue;
+        }
+        fills[c].push_back({std::move(facets), static_cast<std::uint32_t>(h0 / 3)});
+    }
+    // A component is filled only when that closes it into a solid: a volume beyond a sheet's of
+    // the weld tolerance's thickness (a loose facet, a flat patch would close into a pillow of
+    // no volume).
+    std::vector<double> volume6(box.size(), 0.0), area(box.size(), 0.0);
+    const auto add_facet = [&](std::uint32_t c, Vec3 a, Vec3 b, Vec3 d) {
+        const Vec3 o = 0.5 * (box[c].min + box[c].max);
+        volume6[c] += dot(a - o, cross(b - o, d - o));
+        area[c] += 0.5 * norm(cross(b - a, d - a));
+    };
+    for (std::uint32_t f = 0; f < nf; ++f) {
+        const std::uint32_t c = comp[f];
+        if (!all_filled[c] || fills[c].empty()) continue;
+        add_facet(c, m.position(m.vertex(FaceId(f), 0)), m.position(m.vertex(FaceId(f), 1)),
+                  m.position(m.vertex(FaceId(f), 2)));
+    }
+    for (std::size_t c = 0; c < box.size(); ++c) {
+        if (!all_filled[c] || fills[c].empty()) continue;
+        for (const Fill& fill : fills[c]) {
+            for (const auto& t : fill.facets) {
+                add_facet(static_cast<std::uint32_t>(c), m.position(VertexId(t[0])),
+                          m.position(VertexId(t[1])), m.position(VertexId(t[2])));
+            }
+        }
+        if (std::abs(volume6[c]) / 6 <= area[c] * built.heal.tolerance) continue;
+        for (const Fill& fill : fills[c]) {
+            ++built.heal.holes_filled;
+            for (const auto& t : fill.facets) {
+                added.push_back(t);
+                added_next_to.push_back(fill.next_to);
+            }
+        }
+    }
+    if (!added.empty()) {
+        const std::size_t count = added.size();
+        Result<BuildResult> r = rebuild(std::move(built), {}, added, added_next_to, options);
+        if (!r.ok()) return r;
+        built = std::move(r).value();
+        built.heal.hole_facets_added = count;
+    }
+    if (progress) progress("fill holes", 1.0);
+    return built;
+}
+
 Result<BuildResult> build_mesh(const TriangleSoup& soup, const HealOptions& options,
                                const ProgressFn& progress) {
-    return MeshBuilder::build(soup, nullptr, options, progress);
+    Result<BuildResult> built = MeshBuilder::build(soup, nullptr, options, progress);
+    if (!built.ok() || !options.fill_holes) return built;
+    return MeshBuilder::fill_holes(std::move(built).value(), options, progress);
 }
 
 Result<BuildResult> build_mesh(TriangleSoup&& soup, const HealOptions& options,
                                const ProgressFn& progress) {
     TriangleSoup owned = std::move(soup);
-    return MeshBuilder::build(owned, &owned, options, progress);
+    Result<BuildResult> built = MeshBuilder::build(owned, &owned, options, progress);
+    if (!built.ok() || !options.fill_holes) return built;
+    return MeshBuilder::fill_holes(std::move(built).value(), options, progress);
 }
 
 }  // namespace ncrev

@@ -31,6 +31,14 @@ std::vector<std::string> make_warnings(const InfoReport& r) {
     if (r.heal.components_turned_outward) {
         w.push_back(n(r.heal.components_turned_outward) + " inside-out components turned outward");
     }
+    if (r.heal.facets_split_at_t_junctions) {
+        w.push_back(n(r.heal.facets_split_at_t_junctions) +
+                    " facets split at T-junctions (vertices in the middle of their open edges)");
+    }
+    if (r.heal.holes_filled) {
+        w.push_back(n(r.heal.holes_filled) + " small holes closed with " +
+                    n(r.heal.hole_facets_added) + " new facets (facets missing from the file)");
+    }
     if (r.heal.cavities_turned_inward) {
         w.push_back(n(r.heal.cavities_turned_inward) +
                     " cavity shells turned inward (they faced out of the cavity)");
@@ -139,6 +147,9 @@ nlohmann::json info_json(const InfoReport& r) {
                     {"cavities", h.cavities},
                     {"cavities_turned_inward", h.cavities_turned_inward},
                     {"nesting_checked", !h.nesting_unchecked},
+                    {"facets_split_at_t_junctions", h.facets_split_at_t_junctions},
+                    {"holes_filled", h.holes_filled},
+                    {"hole_facets_added", h.hole_facets_added},
                     {"nonmanifold_edges", h.nonmanifold_edges},
                     {"nonmanifold_vertices", h.nonmanifold_vertices},
                     {"orientation_conflicts", h.orientation_conflicts}};
