@@ -170,6 +170,17 @@ std::size_t faces_on_one_surface(const Mesh& mesh, std::span<const SampleFace> f
     return count;
 }
 
+/// What an STL carries of a sample's mesh: the triangles only.
+TriangleSoup as_stl(TriangleSoup soup) {
+    soup.format = InputFormat::kStlBinary;
+    soup.color.clear();
+    soup.cut.clear();
+    soup.surface.clear();
+    soup.surfaces.clear();
+    soup.tools.clear();
+    return soup;
+}
+
 /// The sample part (or STEP file's solid) tessellated, healed, reversed, written and read back.
 Outcome reverse_part(const SamplePart& part, bool sre, ReverseMethod method,
                      const std::string& tag) {
@@ -195,16 +206,8 @@ Outcome reverse_part(const SamplePart& part, bool sre, ReverseMethod method,
         if (f.surface < 0) o.analytic_only = false;
         ++o.true_kinds[f.kind];
     }
-    TriangleSoup soup = part.mesh;
-    soup.format = sre ? InputFormat::kSre : InputFormat::kStlBinary;
-    if (!sre) {
-        // What an STL carries: the triangles only.
-        soup.color.clear();
-        soup.cut.clear();
-        soup.surface.clear();
-        soup.surfaces.clear();
-        soup.tools.clear();
-    }
+    TriangleSoup soup = sre ? part.mesh : as_stl(part.mesh);
+    if (sre) soup.format = InputFormat::kSre;
     Result<BuildResult> built = build_mesh(std::move(soup));
     EXPECT_TRUE(built.ok());
     o.mesh = compute_stats(built->mesh);
@@ -425,21 +428,14 @@ TEST(ReverseSurfaces, SreToolColorsBecomeFaceColors) {
 TEST(ReverseSurfaces, OpenMeshIsPlanarInAutoAndNothingInSurfaces) {
     SamplePart part = make("slot_plate", kFine);
     const std::int64_t face = part.mesh.cut.front();
-    TriangleSoup open = part.mesh;
+    TriangleSoup open = as_stl(part.mesh);
     open.triangles.clear();
-    open.color.clear();
-    open.cut.clear();
-    open.surface.clear();
     for (std::size_t k = 0; k < part.mesh.triangles.size(); ++k) {
-        if (part.mesh.cut[k] == face) continue;
-        open.triangles.push_back(part.mesh.triangles[k]);
-        open.color.push_back(part.mesh.color[k]);
-        open.cut.push_back(part.mesh.cut[k]);
-        open.surface.push_back(part.mesh.surface[k]);
+        if (part.mesh.cut[k] != face) open.triangles.push_back(part.mesh.triangles[k]);
     }
     Result<BuildResult> built = build_mesh(std::move(open));
-    EXPECT_EQ(built->heal.holes_filled, 0u);
     ASSERT_TRUE(built.ok());
+    EXPECT_EQ(built->heal.holes_filled, 0u);
     ReverseOptions ro;
     ro.method = ReverseMethod::kSurfaces;
     const auto path = out_dir() / "open_surfaces.step";
@@ -459,12 +455,7 @@ TEST(ReverseSurfaces, OpenMeshIsPlanarInAutoAndNothingInSurfaces) {
 TEST(ReverseSurfaces, MissingFacetsAreFilledAndThePartIsWhole) {
     const SamplePart part = make("slot_plate", kFine);
     const Outcome whole = reverse_part(part, false, ReverseMethod::kAuto, "holes_reference");
-    TriangleSoup holed = part.mesh;
-    holed.color.clear();
-    holed.cut.clear();
-    holed.surface.clear();
-    holed.surfaces.clear();
-    holed.tools.clear();
+    TriangleSoup holed = as_stl(part.mesh);
     // Every 37th facet but those sharing a point with one already gone: missing facets apart
     // from each other (on its planes, bores and slot walls), each a hole of three edges. Two
     // large planar facets gone side by side would be an opening (docs/healing.md 8).
@@ -530,13 +521,7 @@ TEST(ReverseSurfaces, StrayOpenPiecesAreLeftOutOfTheSolid) {
     const Outcome whole = reverse_part(part, false, ReverseMethod::kAuto, "stray_reference");
     for (const ReverseMethod method : {ReverseMethod::kAuto, ReverseMethod::kSurfaces}) {
         const std::string tag = method == ReverseMethod::kAuto ? "stray_auto" : "stray_surfaces";
-        TriangleSoup stl = soup;
-        stl.color.clear();
-        stl.cut.clear();
-        stl.surface.clear();
-        stl.surfaces.clear();
-        stl.tools.clear();
-        Result<BuildResult> built = build_mesh(std::move(stl));
+        Result<BuildResult> built = build_mesh(as_stl(soup));
         ASSERT_TRUE(built.ok());
         const auto path = out_dir() / (tag + ".step");
         ReverseOptions ro;
@@ -570,13 +555,8 @@ TEST(ReverseSurfaces, StrayOpenPiecesAreLeftOutOfTheSolid) {
     }
     // Mostly open: the part with most of its facets gone, beside a closed cube. Planar as a
     // whole (shells), and nothing with require_solid.
-    TriangleSoup open = part.mesh;
+    TriangleSoup open = as_stl(part.mesh);
     open.triangles.resize(open.triangles.size() / 2);
-    open.color.clear();
-    open.cut.clear();
-    open.surface.clear();
-    open.surfaces.clear();
-    open.tools.clear();
     {
         const auto base = static_cast<std::uint32_t>(open.points.size());
         const double c = 0.01 * size;
