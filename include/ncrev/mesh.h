@@ -42,6 +42,8 @@ using FaceMap = IdMap<FaceId, T>;
 template <class T>
 using HalfedgeMap = IdMap<HalfedgeId, T>;
 
+struct Components;
+
 /// A triangle mesh with half-edge connectivity. Built by build_mesh(); immutable afterwards.
 class Mesh {
    public:
@@ -124,7 +126,7 @@ class Mesh {
 
    private:
     friend class MeshBuilder;
-    friend Mesh keep_components(const Mesh& mesh, std::span<const std::uint32_t> component,
+    friend Mesh keep_components(const Mesh& mesh, const Components& components,
                                 std::span<const std::uint8_t> keep);
     std::vector<Vec3> position_;
     std::vector<std::uint32_t> origin_;
@@ -221,22 +223,32 @@ Result<BuildResult> build_mesh(TriangleSoup&& soup, const HealOptions& options =
 /// Counts, area, volume, bounding box, boundary loops of a mesh.
 MeshStats compute_stats(const Mesh& mesh);
 
-/// Each facet's component: facets joined across shared edges, numbered from 0 in the order of
-/// their first facet (MeshStats::components of them).
-std::vector<std::uint32_t> face_components(const Mesh& mesh);
+/// A mesh's components: facets joined across shared edges.
+struct Components {
+    /// Per facet, its component, numbered from 0 in the order of their first facet.
+    std::vector<std::uint32_t> of_face;
+    /// Per component: closed (none of its edges on a boundary).
+    std::vector<std::uint8_t> closed;
+    std::size_t count() const { return closed.size(); }  ///< MeshStats::components
+};
+Components face_components(const Mesh& mesh);
 
-/// The faces of `mesh` whose component (`component[f]`, as face_components() numbers them) is
-/// kept (`keep[component]` nonzero), as a mesh of its own. Whole components, so every half-edge
-/// keeps its twin and every vertex its fan. Vertices and faces keep their order; each face its
-/// source face (input_labels() still names the input facets) and its SRE attributes.
-Mesh keep_components(const Mesh& mesh, std::span<const std::uint32_t> component,
+/// The boundary loops of a mesh, each its boundary half-edges in order: from one, the next
+/// starts at its target and is that vertex's outgoing half-edge (the one without twin).
+std::vector<std::vector<HalfedgeId>> boundary_loops(const Mesh& mesh);
+
+/// The faces of `mesh` whose component (`components` of it) is kept (`keep[component]`
+/// nonzero), as a mesh of its own. Whole components, so every half-edge keeps its twin and every
+/// vertex its fan. Vertices and faces keep their order; each face its source face
+/// (input_labels() still names the input facets) and its SRE attributes.
+Mesh keep_components(const Mesh& mesh, const Components& components,
                      std::span<const std::uint8_t> keep);
 
 /// How the closed components of a mesh lie in one another: a cavity's shell inside its part,
 /// an island in the cavity inside both.
 struct ComponentNesting {
     static constexpr std::uint32_t kNone = 0xffffffffu;
-    std::vector<std::uint32_t> component;  ///< per facet, as face_components() numbers them
+    Components components;              ///< face_components()
     std::vector<std::uint32_t> parent;  ///< per component: the closed one right around it, or kNone
     /// Per component: how many closed components lie around it; odd: a cavity's shell.
     std::vector<std::uint32_t> depth;

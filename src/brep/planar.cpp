@@ -89,7 +89,7 @@ void number_bodies(PlanarTopology& topo, const Mesh& m, const ComponentNesting* 
         if (component[b] != kNone) continue;
         const std::uint32_t seg = topo.faces[f].loops.front().edges.front().first;
         const HalfedgeId h = m.outgoing(VertexId(topo.segments[seg][0]));
-        component[b] = nesting->component[h.idx() / 3];
+        component[b] = nesting->components.of_face[h.idx() / 3];
         body_of[component[b]] = b;
     }
     for (std::uint32_t b = 0; b < topo.bodies; ++b) {

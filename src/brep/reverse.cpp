@@ -711,29 +711,23 @@ Result<ReverseReport> reverse_surfaces(const Mesh& mesh, const MeshStats& stats,
 /// mesh whose open components hold most of it (an open part, a sheet) has none: it is built
 /// with the planar method as a whole.
 struct ClosedPart {
-    std::vector<std::uint32_t> component;  ///< per face of the whole mesh
-    std::vector<std::uint8_t> kept;        ///< per component: closed
-    Mesh mesh;                             ///< the closed components
+    Components components;  ///< of the whole mesh
+    Mesh mesh;              ///< its closed components
 };
 constexpr double kPartShare = 0.5;
 
 std::optional<ClosedPart> closed_part(const Mesh& mesh) {
     ClosedPart part;
-    part.component = face_components(mesh);
-    const std::uint32_t count = *std::max_element(part.component.begin(), part.component.end()) + 1;
-    part.kept.assign(count, 1);
-    for (std::size_t h = 0; h < mesh.num_halfedges(); ++h) {
-        if (!mesh.twin(HalfedgeId(static_cast<std::uint32_t>(h))).is_valid())
-            part.kept[part.component[h / 3]] = 0;
-    }
+    part.components = face_components(mesh);
+    const Components& c = part.components;
     double closed_area = 0, area = 0;
     for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
         const double a = mesh.face_area(FaceId(f));
         area += a;
-        if (part.kept[part.component[f]]) closed_area += a;
+        if (c.closed[c.of_face[f]]) closed_area += a;
     }
     if (closed_area <= kPartShare * area) return std::nullopt;
-    part.mesh = keep_components(mesh, part.component, part.kept);
+    part.mesh = keep_components(mesh, c, c.closed);
     return part;
 }
 
@@ -778,7 +772,8 @@ Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::p
                 FaceMap<std::int32_t> region(mesh.num_faces(), -1);
                 std::uint32_t k = 0;
                 for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
-                    if (part->kept[part->component[f]])
+                    const Components& c = part->components;
+                    if (c.closed[c.of_face[f]])
                         region[FaceId(f)] = out->segmentation->region[FaceId(k++)];
                 }
                 out->segmentation->region = std::move(region);

@@ -948,7 +948,7 @@ std::map<std::uint32_t, std::vector<std::uint32_t>> t_junctions(const Mesh& m, d
             by[axis].emplace_back(m.position(VertexId(v))[axis], v);
         std::sort(by[axis].begin(), by[axis].end());
     }
-    std::map<std::uint32_t, std::uint32_t> face_edge;
+    std::vector<std::uint32_t> twice;  // faces with a second such edge
     for (const std::uint32_t h : edges) {
         const Vec3 p = m.position(m.origin(HalfedgeId(h))), q = m.position(m.target(HalfedgeId(h)));
         const double len = norm(q - p);
@@ -972,17 +972,14 @@ std::map<std::uint32_t, std::vector<std::uint32_t>> t_junctions(const Mesh& m, d
         std::sort(inside.begin(), inside.end());
         const std::uint32_t f = h / 3;
         if (out.count(f)) {
-            face_edge[f] = HalfedgeId::kInvalid;  // a second edge: left alone
+            twice.push_back(f);
             continue;
         }
         std::vector<std::uint32_t> split{h};
         for (const auto& [t, v] : inside) split.push_back(v);
         out.emplace(f, std::move(split));
-        face_edge[f] = h;
     }
-    for (const auto& [f, h] : face_edge) {
-        if (h == HalfedgeId::kInvalid) out.erase(f);
-    }
+    for (const std::uint32_t f : twice) out.erase(f);
     return out;
 }
 
@@ -990,8 +987,10 @@ std::map<std::uint32_t, std::vector<std::uint32_t>> t_junctions(const Mesh& m, d
 
 /// `built`'s faces again, those in `split` split along one edge at the vertices on it, then the
 /// facets `added` (each beside face `added_next_to[k]`), built with the same options (holes
-/// and cracks aside): the faces keep their input facets, the added ones have none, and the
-/// report adds the second build's counts to the first's.
+/// and cracks aside): the faces keep their input facets, the added ones have none. The report
+/// is the first build's, with what the second found among the new facets (degenerate ones,
+/// caps, duplicates); its other counts (non-manifold edges and vertices, flips, conflicts)
+/// find the first build's defects again, in its vertices that the exact weld joins again.
 Result<BuildResult> MeshBuilder::rebuild(
     BuildResult built, const std::map<std::uint32_t, std::vector<std::uint32_t>>& split,
     const std::vector<std::array<std::uint32_t, 3>>& added,
@@ -1043,10 +1042,6 @@ Result<BuildResult> MeshBuilder::rebuild(
     heal.degenerate_facets_removed += second.degenerate_facets_removed;
     heal.caps_split += second.caps_split;
     heal.duplicate_facets_removed += second.duplicate_facets_removed;
-    heal.flipped_facets += second.flipped_facets;
-    heal.nonmanifold_edges += second.nonmanifold_edges;
-    heal.nonmanifold_vertices += second.nonmanifold_vertices;
-    heal.orientation_conflicts += second.orientation_conflicts;
     rebuilt->heal = std::move(heal);
     return rebuilt;
 }
@@ -1075,13 +1070,13 @@ Result<BuildResult> MeshBuilder::fill_holes(BuildResult built, const HealOptions
         }
     }
     const Mesh& m = built.mesh;
-    const std::size_t nh = m.num_halfedges(), nf = m.num_faces();
+    const std::size_t nf = m.num_faces();
     std::vector<std::array<std::uint32_t, 3>> added;
     std::vector<std::uint32_t> added_next_to;  // a face beside each added facet's loop
-    const std::vector<std::uint32_t> comp = face_components(m);
-    std::vector<Box3> box;
+    const Components components = face_components(m);
+    const std::vector<std::uint32_t>& comp = components.of_face;
+    std::vector<Box3> box(components.count());
     for (std::size_t f = 0; f < nf; ++f) {
-        if (comp[f] >= box.size()) box.resize(comp[f] + 1);
         for (int i = 0; i < 3; ++i)
             box[comp[f]].add(m.position(m.vertex(FaceId(static_cast<std::uint32_t>(f)), i)));
     }
@@ -1092,32 +1087,25 @@ Result<BuildResult> MeshBuilder::fill_holes(BuildResult built, const HealOptions
     };
     std::vector<std::vector<Fill>> fills(box.size());
     std::vector<std::uint8_t> all_filled(box.size(), 1);
-    std::vector<std::uint8_t> seen(nh, 0);
     std::vector<std::uint32_t> loop;
-    for (std::size_t h0 = 0; h0 < nh; ++h0) {
-        if (seen[h0] || m.twins()[h0] != HalfedgeId::kInvalid) continue;
+    for (const std::vector<HalfedgeId>& edges : boundary_loops(m)) {
         loop.clear();
         double perimeter = 0;
-        HalfedgeId g(static_cast<std::uint32_t>(h0));
-        for (std::size_t guard = 0; guard <= nh && !seen[g.idx()]; ++guard) {
-            seen[g.idx()] = 1;
+        for (const HalfedgeId g : edges) {
             loop.push_back(m.origin(g).idx());
             perimeter += norm(m.position(m.target(g)) - m.position(m.origin(g)));
-            g = m.outgoing(m.target(g));
-            if (!m.is_boundary(g)) break;  // cannot happen on a valid mesh
         }
-        const std::uint32_t c = comp[h0 / 3];
+        const std::uint32_t face = edges.front().idx() / 3, c = comp[face];
         // One missing facet (three edges), or a hole small beside its part.
         const bool small = loop.size() == 3 || (loop.size() <= kMaxHoleEdges &&
                                                 perimeter <= kMaxHolePerimeter * box[c].diagonal());
-        auto facets = g.idx() == h0 && loop.size() >= 3 && small
-                          ? close_loop(m, loop)
-                          : std::vector<std::array<std::uint32_t, 3>>{};
+        auto facets = loop.size() >= 3 && small ? close_loop(m, loop)
+                                                : std::vector<std::array<std::uint32_t, 3>>{};
         if (facets.empty()) {
             all_filled[c] = 0;
             continue;
         }
-        fills[c].push_back({std::move(facets), static_cast<std::uint32_t>(h0 / 3)});
+        fills[c].push_back({std::move(facets), face});
     }
     // A component is filled only when that closes it into a solid: a volume beyond a sheet's of
     // the weld tolerance's thickness (a loose facet, a flat patch would close into a pillow of

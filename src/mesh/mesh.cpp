@@ -79,15 +79,16 @@ std::string Mesh::validate() const {
     return {};
 }
 
-std::vector<std::uint32_t> face_components(const Mesh& mesh) {
+Components face_components(const Mesh& mesh) {
     const std::size_t nf = mesh.num_faces();
-    std::vector<std::uint32_t> comp;
+    Components out;
+    std::vector<std::uint32_t>& comp = out.of_face;
     detail::assign_huge(comp, nf, std::uint32_t{HalfedgeId::kInvalid});
     std::vector<std::uint32_t> stack;
-    std::uint32_t count = 0;
     for (std::size_t seed = 0; seed < nf; ++seed) {
         if (comp[seed] != HalfedgeId::kInvalid) continue;
-        const std::uint32_t id = count++;
+        const auto id = static_cast<std::uint32_t>(out.closed.size());
+        out.closed.push_back(1);
         comp[seed] = id;
         stack.push_back(static_cast<std::uint32_t>(seed));
         while (!stack.empty()) {
@@ -95,19 +96,40 @@ std::vector<std::uint32_t> face_components(const Mesh& mesh) {
             stack.pop_back();
             for (int k = 0; k < 3; ++k) {
                 const std::uint32_t t = mesh.twins()[3 * f + k];
-                if (t == HalfedgeId::kInvalid) continue;
-                if (comp[t / 3] == HalfedgeId::kInvalid) {
+                if (t == HalfedgeId::kInvalid) {
+                    out.closed[id] = 0;
+                } else if (comp[t / 3] == HalfedgeId::kInvalid) {
                     comp[t / 3] = id;
                     stack.push_back(t / 3);
                 }
             }
         }
     }
-    return comp;
+    return out;
 }
 
-Mesh keep_components(const Mesh& mesh, std::span<const std::uint32_t> component,
+std::vector<std::vector<HalfedgeId>> boundary_loops(const Mesh& mesh) {
+    std::vector<std::vector<HalfedgeId>> loops;
+    const std::size_t nh = mesh.num_halfedges();
+    std::vector<std::uint8_t> seen;
+    for (std::size_t h = 0; h < nh; ++h) {
+        if (mesh.twins()[h] != HalfedgeId::kInvalid || (!seen.empty() && seen[h])) continue;
+        if (seen.empty()) seen.assign(nh, 0);  // a closed mesh needs none
+        std::vector<HalfedgeId>& loop = loops.emplace_back();
+        HalfedgeId g(static_cast<std::uint32_t>(h));
+        for (std::size_t guard = 0; guard <= nh && !seen[g.idx()]; ++guard) {
+            seen[g.idx()] = 1;
+            loop.push_back(g);
+            g = mesh.outgoing(mesh.target(g));
+            if (!mesh.is_boundary(g)) break;  // cannot happen on a valid mesh
+        }
+    }
+    return loops;
+}
+
+Mesh keep_components(const Mesh& mesh, const Components& components,
                      std::span<const std::uint8_t> keep) {
+    const std::vector<std::uint32_t>& component = components.of_face;
     constexpr std::uint32_t kNone = HalfedgeId::kInvalid;
     const std::size_t nf = mesh.num_faces(), nv = mesh.num_vertices();
     std::vector<std::uint32_t> face_to(nf, kNone), vertex_to(nv, kNone);
@@ -148,15 +170,10 @@ Mesh keep_components(const Mesh& mesh, std::span<const std::uint32_t> component,
 
 ComponentNesting component_nesting(const Mesh& mesh) {
     ComponentNesting out;
-    out.component = face_components(mesh);
-    const std::uint32_t count =
-        out.component.empty() ? 0
-                              : *std::max_element(out.component.begin(), out.component.end()) + 1;
-    std::vector<std::uint8_t> closed(count, 1);
-    for (std::size_t h = 0; h < mesh.num_halfedges(); ++h) {
-        if (mesh.twins()[h] == HalfedgeId::kInvalid) closed[out.component[h / 3]] = 0;
-    }
-    detail::Nesting n = detail::nest_components(out.component, count, closed, [&](std::uint32_t f) {
+    out.components = face_components(mesh);
+    const Components& c = out.components;
+    const auto count = static_cast<std::uint32_t>(c.count());
+    detail::Nesting n = detail::nest_components(c.of_face, count, c.closed, [&](std::uint32_t f) {
         return std::array<Vec3, 3>{mesh.position(mesh.vertex(FaceId(f), 0)),
                                    mesh.position(mesh.vertex(FaceId(f), 1)),
                                    mesh.position(mesh.vertex(FaceId(f), 2))};
@@ -197,24 +214,9 @@ MeshStats compute_stats(const Mesh& mesh) {
     s.area = area;
     s.volume = vol6 / 6.0;
 
-    // Components: faces joined across twins.
-    const std::vector<std::uint32_t> comp = face_components(mesh);
-    if (!comp.empty()) s.components = *std::max_element(comp.begin(), comp.end()) + 1u;
-
-    // Boundary loops: from a boundary half-edge, the next one starts at its target and is
-    // that vertex's outgoing half-edge (the one without twin).
-    std::vector<std::uint8_t> seen(boundary > 0 ? nh : 0, 0);  // a closed mesh has none
-    for (std::size_t h = 0; h < nh && boundary > 0; ++h) {
-        if (seen[h] || mesh.twins()[h] != HalfedgeId::kInvalid) continue;
-        std::uint32_t len = 0;
-        HalfedgeId g(static_cast<std::uint32_t>(h));
-        for (std::size_t guard = 0; guard <= nh && !seen[g.idx()]; ++guard) {
-            seen[g.idx()] = 1;
-            ++len;
-            g = mesh.outgoing(mesh.target(g));
-            if (!mesh.is_boundary(g)) break;  // cannot happen on a valid mesh
-        }
-        s.boundary_loop_sizes.push_back(len);
+    s.components = face_components(mesh).count();
+    for (const auto& loop : boundary_loops(mesh)) {
+        s.boundary_loop_sizes.push_back(static_cast<std::uint32_t>(loop.size()));
     }
     std::sort(s.boundary_loop_sizes.begin(), s.boundary_loop_sizes.end(), std::greater<>());
     s.boundary_loops = s.boundary_loop_sizes.size();
