@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "analytic_shapes.h"
+#include "detail/triangle_tree.h"
 #include "ncrev/io.h"
 #include "ncrev/mesh.h"
 
@@ -98,7 +99,7 @@ void expect_brute_force_distances(int around, int along) {
         for (const Vec3& p : points) {
             double best = 1e300;
             for (const auto& t : to) {
-                const Vec3 q = brep_detail::closest_on_triangle(p, t[0], t[1], t[2]);
+                const Vec3 q = detail::closest_on_triangle(p, t[0], t[1], t[2]);
                 best = std::min(best, dot(p - q, p - q));
             }
             mx = std::max(mx, std::sqrt(best));

@@ -38,7 +38,4 @@ std::vector<std::array<double, 3>> untriangulated_faces(const TopoDS_Shape& shap
 std::vector<double> faces_from_mesh(std::span<const TopoDS_Face> faces, const Mesh& mesh,
                                     double deflection);
 
-/// The point of triangle abc closest to p.
-Vec3 closest_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c);
-
 }  // namespace ncrev::brep_detail

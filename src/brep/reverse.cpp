@@ -22,6 +22,7 @@
 #include "brep/planar.h"
 #include "brep/step.h"
 #include "brep/surfaces.h"
+#include "detail/triangle_tree.h"
 #include "ncrev/brep.h"
 
 namespace ncrev {
@@ -261,9 +262,9 @@ std::size_t regions_near(const Mesh& mesh, const FaceMap<std::int32_t>& labels,
         std::vector<std::size_t> curved, flat;
         for (std::uint32_t f = 0; f < mesh.num_faces(); ++f) {
             const FaceId id(f);
-            const Vec3 q = brep_detail::closest_on_triangle(p, mesh.position(mesh.vertex(id, 0)),
-                                                            mesh.position(mesh.vertex(id, 1)),
-                                                            mesh.position(mesh.vertex(id, 2)));
+            const Vec3 q = detail::closest_on_triangle(p, mesh.position(mesh.vertex(id, 0)),
+                                                       mesh.position(mesh.vertex(id, 1)),
+                                                       mesh.position(mesh.vertex(id, 2)));
             if (norm(q - p) > radius) continue;
             auto r = static_cast<std::size_t>(labels[id]);
             // A sliver absorbed by a neighbour is that neighbour's face now.
