@@ -1,6 +1,7 @@
 // Fuzz target: mesh building and healing on arbitrary facet soups (coordinates from a small
 // lattice so that welds, duplicates, non-manifold edges and vertices are frequent). The mesh
-// must always satisfy its invariants, and the components' nesting stay within its components.
+// must always satisfy its invariants, and the components' nesting and crossing pairs stay within
+// its components.
 #include <cstdlib>
 #include <cstring>
 
@@ -35,5 +36,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (p != ncrev::ComponentNesting::kNone && (p >= stats.components || p == c)) std::abort();
         if ((p == ncrev::ComponentNesting::kNone) != (nesting.depth[c] == 0)) std::abort();
     }
+    // Crossing pairs: sorted, of two distinct closed components, never one inside the other.
+    for (std::size_t i = 0; i < nesting.crossing.size(); ++i) {
+        const auto [a, b] = nesting.crossing[i];
+        if (!(a < b) || b >= stats.components || !nesting.components.closed[a] ||
+            !nesting.components.closed[b])
+            std::abort();
+        if (i > 0 && !(nesting.crossing[i - 1] < nesting.crossing[i])) std::abort();
+        if (nesting.parent[a] == b || nesting.parent[b] == a) std::abort();
+    }
+    if (r->heal.crossing_components > stats.components) std::abort();
     return 0;
 }

@@ -118,6 +118,36 @@ TEST(CliInfo, ACavityIsCountedAndItsVolumeIsNotMaterial) {
     std::filesystem::remove(path);
 }
 
+// Two cubes overlapping without their union (a part's bodies written as one mesh): info and
+// reverse say they cross; reverse keeps each a solid of its own, the volume both cubes'.
+TEST(CliInfo, PartsThatCrossAreReported) {
+    const auto m = test::merge(test::cube({0, 0, 0}, 2.0), test::cube({1, 1, 1}, 2.0));
+    const auto path = write_temp("ncrev_cli_cross.stl", encode_stl_binary(m.points, m.triangles));
+    const CliRun r = run("info --json " + path.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["healing"]["crossing_components"], 2);
+    EXPECT_EQ(j["healing"]["crossing_checked"], true);
+    EXPECT_EQ(j["healing"]["cavities"], 0);
+    EXPECT_NE(r.err.find("2 closed components cross one another"), std::string::npos) << r.err;
+    const auto step = test::scratch_dir() / "ncrev_cli_cross.step";
+    for (const char* method : {"auto", "planar"}) {
+        const CliRun rev = run("reverse " + path.string() + " -o " + step.string() + " --method " +
+                               method + " --json");
+        ASSERT_EQ(rev.code, 0) << method << rev.err;
+        const auto jr = nlohmann::json::parse(rev.out);
+        EXPECT_EQ(jr["reverse"]["bodies"], 2) << method;
+        EXPECT_EQ(jr["healing"]["crossing_components"], 2) << method;
+        EXPECT_NEAR(jr["reverse"]["solid_volume"].template get<double>(), 16.0, 1e-9) << method;
+        bool warned = false;
+        for (const auto& w : jr["warnings"])
+            warned = warned || w.get<std::string>().find("cross one another") != std::string::npos;
+        EXPECT_TRUE(warned) << method;
+    }
+    std::filesystem::remove(step);
+    std::filesystem::remove(path);
+}
+
 // A ball that lost a facet: healing fills the hole and says so; --keep-holes shows it open.
 TEST(CliInfo, FillsASmallHoleUnlessToldToKeepIt) {
     auto m = test::icosphere(10.0, 3);

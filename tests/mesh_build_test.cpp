@@ -181,7 +181,81 @@ TEST(MeshBuild, APartPokingThroughAnotherIsNoCavity) {
     for (const bool pokes : {true, false}) {
         const BuildResult b = build_ok(test::to_bucket(test::merge(ball, pokes ? bar : inside)));
         EXPECT_EQ(b.heal.cavities, pokes ? 0u : 1u) << pokes;
+        EXPECT_EQ(b.heal.crossing_components, pokes ? 2u : 0u) << pokes;
         EXPECT_EQ(component_nesting(b.mesh).depth[1], pokes ? 0u : 1u) << pokes;
+    }
+}
+
+// Parts that cross (meshes overlapping without their union) are found, whether a corner of one
+// lies in the other (two cubes) or none does (a plus of two bars through each other's sides), and
+// are never nested; parts that only touch (a cube resting on another, turned and written in
+// float32, so that the contact is off by rounding) and a cavity do not cross.
+TEST(MeshBuild, PartsThatCrossAreFoundAndNeverNested) {
+    const auto box = [](Vec3 lo, Vec3 hi) {
+        test::Indexed b = test::cube();
+        for (Vec3& p : b.points)
+            p = lo + Vec3{(hi.x - lo.x) * p.x, (hi.y - lo.y) * p.y, (hi.z - lo.z) * p.z};
+        return b;
+    };
+    const auto crossing = [](const test::Indexed& m, bool turn) {
+        TriangleSoup soup = test::to_bucket(m);
+        if (turn) {
+            test::rigid_motion(soup, 0.7, {3, -2, 5});
+            for (Vec3& p : soup.points)
+                p = Vec3{static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
+        }
+        return build_ok(soup);
+    };
+    // Each facet in four at its edges' middles, `times` times.
+    const auto finer = [](test::Indexed m, int times) {
+        for (int k = 0; k < times; ++k) {
+            std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> middle;
+            const auto mid = [&](std::uint32_t a, std::uint32_t b) {
+                const auto key = std::minmax(a, b);
+                const auto [it, fresh] =
+                    middle.try_emplace(key, static_cast<std::uint32_t>(m.points.size()));
+                if (fresh) m.points.push_back(0.5 * (m.points[a] + m.points[b]));
+                return it->second;
+            };
+            std::vector<test::Tri> next;
+            for (const test::Tri& t : m.triangles) {
+                const std::uint32_t ab = mid(t[0], t[1]), bc = mid(t[1], t[2]),
+                                    ca = mid(t[2], t[0]);
+                next.insert(next.end(),
+                            {{t[0], ab, ca}, {ab, t[1], bc}, {ca, bc, t[2]}, {ab, bc, ca}});
+            }
+            m.triangles = std::move(next);
+        }
+        return m;
+    };
+    const test::Indexed cubes = test::merge(test::cube({0, 0, 0}, 10), test::cube({5, 5, 5}, 10));
+    // The same, the first cube in 49152 facets: the second's edges pass through its facets'
+    // corners, and which end is inside is asked in a tree of the whole first cube, built in
+    // parallel. (Both so fine would share vertices where they cross, which the weld joins.)
+    const test::Indexed fine_cubes =
+        test::merge(finer(test::cube({0, 0, 0}, 10), 6), test::cube({5, 5, 5}, 10));
+    const test::Indexed plus =
+        test::merge(box({0, 10, 0}, {30, 20, 10}), box({10, 0, 2}, {20, 30, 8}));
+    const test::Indexed resting =
+        test::merge(test::cube({0, 0, 0}, 10), test::cube({3, 3, 10}, 10));
+    const test::Indexed cavity = test::merge(test::cube({0, 0, 0}, 10), test::cube({2, 2, 2}, 6));
+    for (const bool turn : {false, true}) {
+        for (const test::Indexed* m : {&cubes, &plus, &fine_cubes}) {
+            const BuildResult b = crossing(*m, turn);
+            EXPECT_EQ(b.heal.crossing_components, 2u) << turn;
+            EXPECT_FALSE(b.heal.crossing_unchecked);
+            EXPECT_EQ(b.heal.cavities, 0u);
+            const ComponentNesting n = component_nesting(b.mesh);
+            EXPECT_TRUE(n.crossing_complete);
+            EXPECT_EQ(n.crossing, (std::vector<std::pair<std::uint32_t, std::uint32_t>>{{0, 1}}));
+            EXPECT_EQ(n.depth, (std::vector<std::uint32_t>{0, 0}));
+        }
+        const BuildResult r = crossing(resting, turn);
+        EXPECT_EQ(r.heal.crossing_components, 0u) << turn;
+        EXPECT_TRUE(component_nesting(r.mesh).crossing.empty());
+        const BuildResult c = crossing(cavity, turn);
+        EXPECT_EQ(c.heal.crossing_components, 0u) << turn;
+        EXPECT_EQ(c.heal.cavities, 1u);
     }
 }
 

@@ -174,6 +174,13 @@ struct HealReport {
     /// Too many components to check which lies inside which (detail::kNestingWork): every
     /// closed component was turned outward, a cavity's shell too.
     bool nesting_unchecked = false;
+    /// Closed components whose surfaces cross another's: meshes of parts that overlap without
+    /// their union (healing joins none). Each stays a whole closed component, and the volume
+    /// counts their overlap twice.
+    std::uint64_t crossing_components = 0;
+    /// Too many facet pairs near one another to check which components cross
+    /// (detail::kNestingWork): none is counted.
+    bool crossing_unchecked = false;
     std::uint64_t nonmanifold_edges = 0;     ///< edges with more than two facets (then split)
     std::uint64_t nonmanifold_vertices = 0;  ///< vertices with more than one fan (then split)
     std::uint64_t orientation_conflicts =
@@ -255,12 +262,17 @@ struct ComponentNesting {
     /// False when there were too many components to check (thousands of loose pieces in one
     /// box): then none counts as nested.
     bool complete = true;
+    /// Pairs (a < b) of closed components whose surfaces cross (an edge of one passes through
+    /// a facet of the other, beyond rounding), sorted: parts overlapping without their union.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
+    /// False when too many facets lay near one another to check: then no pair is listed.
+    bool crossing_complete = true;
 };
 
 /// Which closed component lies inside which, by the parity of ray crossings from its extreme
-/// vertices (three rays each, the majority; all six inside, so that two parts that cross are
-/// not nested), tested only where one's box lies in the other's. Open components are neither
-/// inside nor around anything.
+/// vertices (three rays each, the majority; all six inside), tested only where one's box lies
+/// in the other's; and which cross each other (never nested). Open components are neither
+/// inside nor around anything, nor cross anything.
 ComponentNesting component_nesting(const Mesh& mesh);
 
 /// Signed dihedral angle at the edge of `h`, in radians, in [-pi, pi]: the angle between the

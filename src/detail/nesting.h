@@ -1,14 +1,25 @@
 // Which closed components of a triangle mesh lie inside which: a cavity's shell lies inside its
-// part, an island inside the cavity inside both. Used by healing (a cavity's shell faces into
-// the cavity) and by the B-rep builders (a cavity is a void of its part's solid).
+// part, an island inside the cavity inside both; and which cross each other (parts overlapping
+// without their union). Used by healing (a cavity's shell faces into the cavity; crossing parts
+// are reported) and by the B-rep builders (a cavity is a void of its part's solid).
 #pragma once
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <cmath>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <span>
+#include <utility>
 #include <vector>
 
+#include "detail/triangle_tree.h"
 #include "ncrev/common.h"
 
 namespace ncrev::detail {
@@ -20,6 +31,46 @@ inline constexpr std::uint64_t kNestingWork = 300'000'000;
 
 inline constexpr std::uint32_t kNotNested = 0xffffffffu;
 
+/// Points nearer each other than this share of the closed components' size count as touching
+/// when no tolerance larger is given: about eight float32 rounding steps at the model's size, as
+/// the weld's default tolerance (a vertex of one part lying on a face of another, written in
+/// float32, is off that face by rounding).
+inline constexpr double kTouchShare = 1e-6;
+
+/// Three directions no mesh of a machined part lines up with, for parity tests.
+inline std::array<Vec3, 3> parity_rays() {
+    return {normalized(Vec3{0.5773, 0.4082, 0.7071}), normalized(Vec3{-0.3162, 0.8944, 0.3169}),
+            normalized(Vec3{0.6325, -0.2236, -0.7416})};
+}
+
+enum class Pierce { kNo, kThrough, kBorder };
+
+/// Whether segment pq passes through triangle t: p and q more than `tol` on either side of its
+/// plane, the point where it meets the plane more than `tol` inside t (kThrough) or within `tol`
+/// of its border (kBorder: through the edge between two facets, or past a convex edge of the
+/// surface without entering it; where two parts cross symmetrically, their edges meet the
+/// other's facets on their diagonals). A segment that only touches t (an end on it, along its
+/// plane) does not.
+inline Pierce pierces(Vec3 p, Vec3 q, const Triangle& t, double tol) {
+    Vec3 n = cross(t[1] - t[0], t[2] - t[0]);
+    const double len = norm(n);
+    if (!(len > 0)) return Pierce::kNo;
+    n = (1 / len) * n;
+    const double dp = dot(p - t[0], n), dq = dot(q - t[0], n);
+    if (!((dp > tol && dq < -tol) || (dp < -tol && dq > tol))) return Pierce::kNo;
+    const Vec3 x = p + (dp / (dp - dq)) * (q - p);
+    Pierce out = Pierce::kThrough;
+    for (std::size_t i = 0; i < 3; ++i) {
+        const Vec3 e = t[(i + 1) % 3] - t[i];
+        const double le = norm(e);
+        if (!(le > 0)) return Pierce::kNo;
+        const double inside = dot(cross(e, x - t[i]), n) / le;
+        if (inside < -tol) return Pierce::kNo;
+        if (inside <= tol) out = Pierce::kBorder;
+    }
+    return out;
+}
+
 struct Nesting {
     /// Per component: the closed component immediately around it, or kNotNested.
     std::vector<std::uint32_t> parent;
@@ -27,7 +78,139 @@ struct Nesting {
     std::vector<std::uint32_t> depth;
     /// False when the work bound stopped the check: then nothing counts as nested.
     bool complete = true;
+    /// Pairs (a < b) of closed components whose surfaces cross (meshes of parts overlapping
+    /// without their union), sorted. Neither lies inside the other.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
+    /// False when the work bound stopped the crossing check: then no pair is listed.
+    bool crossing_complete = true;
 };
+
+/// The pairs (a < b) of closed components whose surfaces cross, sorted: an edge of a facet of
+/// one passes through a facet of the other (pierces(), within `tol`), or through its border
+/// from outside the other component to inside it (each end off its surface by more than `tol`;
+/// inside by the parity of rays, as nesting tests). Parts that only touch (a face on a face, an
+/// edge along a face or across an edge) do not cross. `pairs`: the pairs whose boxes meet; of
+/// each, only the facets within both boxes are compared (one side's through a tree of the
+/// other's). Empty, with `complete` false, when the facets to compare, summed over the pairs,
+/// pass kNestingWork.
+template <class Corners>
+std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
+    std::span<const std::uint32_t> component, std::uint32_t count,
+    std::span<const std::pair<std::uint32_t, std::uint32_t>> pairs, std::span<const Box3> box,
+    double tol, const Corners& corners, bool& complete) {
+    using Pair = std::pair<std::uint32_t, std::uint32_t>;
+    std::vector<Pair> out;
+    std::vector<std::vector<std::uint32_t>> facets(count);
+    {
+        std::vector<std::uint8_t> used(count, 0);
+        for (const auto& [a, b] : pairs) used[a] = used[b] = 1;
+        for (std::uint32_t f = 0; f < component.size(); ++f)
+            if (used[component[f]]) facets[component[f]].push_back(f);
+    }
+    const auto grown = [&](Box3 b) {
+        for (int k = 0; k < 3; ++k) b.min[k] -= tol, b.max[k] += tol;
+        return b;
+    };
+    const auto meets = [](const Box3& a, const Box3& b) {
+        for (int k = 0; k < 3; ++k)
+            if (a.max[k] < b.min[k] || b.max[k] < a.min[k]) return false;
+        return true;
+    };
+    const auto box_of = [](const Triangle& t) {
+        Box3 b;
+        for (int k = 0; k < 3; ++k) {
+            b.min[k] = std::min({t[0][k], t[1][k], t[2][k]});
+            b.max[k] = std::max({t[0][k], t[1][k], t[2][k]});
+        }
+        return b;
+    };
+    // A whole component's tree, made when a segment through a facet's border asks whether its
+    // ends are in that component (rare: symmetric parts).
+    std::vector<std::unique_ptr<TriangleTree>> whole(count);
+    std::vector<std::once_flag> made(count);
+    const std::array<Vec3, 3> rays = parity_rays();
+    const auto in = [&](Vec3 p, std::uint32_t c, bool& off) {
+        // Made in isolation: a thread waiting for the tree's parallel parts takes no other
+        // facet's test, which could wait for this same tree (a deadlock).
+        std::call_once(made[c], [&] {
+            tbb::this_task_arena::isolate([&] {
+                std::vector<Triangle> tris(facets[c].size());
+                for (std::size_t i = 0; i < tris.size(); ++i) tris[i] = corners(facets[c][i]);
+                whole[c] = std::make_unique<TriangleTree>(std::move(tris));
+            });
+        });
+        const auto all = [](std::uint32_t) { return true; };
+        off = whole[c]->distance(p) > tol;
+        if (!off) return false;
+        int odd = 0;
+        for (const Vec3& d : rays) odd += static_cast<int>(whole[c]->ray_hits_if(p, d, all) % 2);
+        return 2 * odd > static_cast<int>(rays.size());
+    };
+    // Whether segment pq of one component passes into or out of component c through t, one of
+    // c's facets: through t, or through its border with one end in c and the other out.
+    const auto passes = [&](Vec3 p, Vec3 q, const Triangle& t, std::uint32_t c) {
+        const Pierce how = pierces(p, q, t, tol);
+        if (how != Pierce::kBorder) return how == Pierce::kThrough;
+        bool p_off = false, q_off = false;
+        const bool p_in = in(p, c, p_off);
+        if (!p_off) return false;
+        const bool q_in = in(q, c, q_off);
+        return q_off && p_in != q_in;
+    };
+    // The facets compared, a bound on the work fixed before any is (the same on every run).
+    std::uint64_t work = 0;
+    for (const auto& [a, b] : pairs) {
+        work += facets[a].size() + facets[b].size();
+        if (work > kNestingWork) {
+            complete = false;
+            return {};
+        }
+    }
+    for (const auto& [a, b] : pairs) {
+        // Where the two boxes overlap.
+        Box3 both;
+        for (int k = 0; k < 3; ++k) {
+            both.min[k] = std::max(box[a].min[k], box[b].min[k]);
+            both.max[k] = std::min(box[a].max[k], box[b].max[k]);
+        }
+        both = grown(both);
+        // The facets of each side within both boxes; the tree over the smaller side (copies of
+        // its triangles), the other side's facets ask it.
+        std::array<std::vector<std::uint32_t>, 2> near;
+        for (std::size_t side = 0; side < 2; ++side) {
+            for (const std::uint32_t f : facets[side == 0 ? a : b])
+                if (meets(box_of(corners(f)), both)) near[side].push_back(f);
+        }
+        if (near[0].empty() || near[1].empty()) continue;
+        const bool tree_a = near[0].size() < near[1].size();
+        const std::uint32_t tc = tree_a ? a : b, qc = tree_a ? b : a;
+        const std::vector<std::uint32_t>& asking = near[tree_a ? 1 : 0];
+        const TriangleTree tree = [&] {
+            std::vector<std::uint32_t>& mine = near[tree_a ? 0 : 1];
+            std::vector<Triangle> tris(mine.size());
+            for (std::size_t i = 0; i < mine.size(); ++i) tris[i] = corners(mine[i]);
+            mine = {};
+            return TriangleTree(std::move(tris));
+        }();
+        std::atomic<bool> found{false};
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, asking.size(), 1024), [&](const auto& r) {
+                for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
+                    const Triangle u = corners(asking[i]);
+                    bool hit = false;
+                    tree.for_each_near(grown(box_of(u)), [&](std::uint32_t, const Triangle& t) {
+                        for (std::size_t k = 0; k < 3 && !hit; ++k) {
+                            hit = passes(u[k], u[(k + 1) % 3], t, tc) ||
+                                  passes(t[k], t[(k + 1) % 3], u, qc);
+                        }
+                    });
+                    if (hit) found = true;
+                }
+            });
+        if (found) out.emplace_back(a, b);
+    }
+    return out;
+}
 
 /// `component[f]`: facet f's component (< `count`); `closed[c]`: component c has no boundary
 /// edge (only closed components have an inside); `corners(f)`: facet f's three points. Open
@@ -37,10 +220,12 @@ struct Nesting {
 /// all), tested only where a's box lies in b's. All six must be inside: two parts that cross
 /// (meshes overlapping without a union, which healing does not join) are not nested, and
 /// where one pokes through the other an extreme vertex is usually what pokes out.
-/// Deterministic; O(facets) when no box lies in another.
+/// Components whose surfaces cross (crossing_components(), `tol` the distance within which
+/// points touch, at least kTouchShare of the components' size) are listed, and never nested.
+/// Deterministic; O(facets) when no box meets another.
 template <class Corners>
 Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t count,
-                        std::span<const std::uint8_t> closed, const Corners& corners) {
+                        std::span<const std::uint8_t> closed, double tol, const Corners& corners) {
     Nesting out;
     out.parent.assign(count, kNotNested);
     out.depth.assign(count, 0);
@@ -71,10 +256,7 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
     const auto candidate = [&](std::uint32_t a, std::uint32_t b) {
         return a != b && closed[a] && closed[b] && inside_box(box[a], box[b]);
     };
-    // Directions no mesh of a machined part lines up with.
-    const std::array<Vec3, 3> rays{normalized(Vec3{0.5773, 0.4082, 0.7071}),
-                                   normalized(Vec3{-0.3162, 0.8944, 0.3169}),
-                                   normalized(Vec3{0.6325, -0.2236, -0.7416})};
+    const std::array<Vec3, 3> rays = parity_rays();
     // The pairs are found twice (here, then tested below) rather than stored: concentric
     // shells by the thousand would make millions of them. Their whole work is counted before
     // any ray is cast, so that a check too large to finish costs no more than this count.
@@ -89,10 +271,35 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
             work += extreme[a].size() * rays.size() * size[b];
         }
         if (work > kNestingWork) {
-            out.complete = false;
+            out.complete = out.crossing_complete = false;
             return out;
         }
     }
+    // Components whose boxes meet (within the touching distance) may cross.
+    Box3 all;
+    for (std::uint32_t c = 0; c < count; ++c)
+        if (closed[c]) all.add(box[c]);
+    const double touch = std::max(tol, kTouchShare * all.diagonal());
+    const auto meet = [&](const Box3& a, const Box3& b) {
+        for (int k = 0; k < 3; ++k) {
+            if (a.max[k] + touch < b.min[k] || b.max[k] + touch < a.min[k]) return false;
+        }
+        return true;
+    };
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (std::uint32_t a = 0; a < count; ++a) {
+        for (std::uint32_t b = a + 1; b < count && closed[a]; ++b) {
+            if (closed[b] && meet(box[a], box[b])) pairs.emplace_back(a, b);
+        }
+    }
+    if (!pairs.empty()) {
+        out.crossing = crossing_components(component, count, pairs, box, touch, corners,
+                                           out.crossing_complete);
+    }
+    const auto crossed = [&](std::uint32_t a, std::uint32_t b) {
+        return std::binary_search(out.crossing.begin(), out.crossing.end(),
+                                  std::pair{std::min(a, b), std::max(a, b)});
+    };
     if (std::find(is_outer.begin(), is_outer.end(), 1) == is_outer.end()) return out;
     std::vector<std::vector<std::uint32_t>> facets(count);
     for (std::uint32_t f = 0; f < component.size(); ++f) {
@@ -101,28 +308,14 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
     std::vector<std::vector<std::uint32_t>> around(count);
     for (std::uint32_t a = 0; a < count; ++a) {
         for (std::uint32_t b = 0; b < count && closed[a]; ++b) {
-            if (!candidate(a, b)) continue;
+            if (!candidate(a, b) || crossed(a, b)) continue;
             bool inside = true;
             for (std::size_t e = 0; e < extreme[a].size() && inside; ++e) {
                 const Vec3 o = extreme[a][e];
                 int odd = 0;
                 for (const Vec3& d : rays) {
                     std::uint64_t hits = 0;
-                    for (const std::uint32_t f : facets[b]) {
-                        const std::array<Vec3, 3> t = corners(f);
-                        const Vec3 e1 = t[1] - t[0];
-                        const Vec3 e2 = t[2] - t[0];
-                        const Vec3 q = cross(d, e2);
-                        const double det = dot(e1, q);
-                        if (det == 0) continue;
-                        const Vec3 s = o - t[0];
-                        const double u = dot(s, q) / det;
-                        if (u < 0 || u > 1) continue;
-                        const Vec3 r = cross(s, e1);
-                        const double v = dot(d, r) / det;
-                        if (v < 0 || u + v > 1) continue;
-                        if (dot(e2, r) / det > 0) ++hits;
-                    }
+                    for (const std::uint32_t f : facets[b]) hits += ray_crosses(o, d, corners(f));
                     odd += static_cast<int>(hits % 2);
                 }
                 inside = 2 * odd > static_cast<int>(rays.size());

@@ -718,12 +718,17 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
         std::vector<std::uint8_t> closed(num_comp, 0);
         for (std::size_t c = 0; c < num_comp; ++c) closed[c] = !open[c];
         const detail::Nesting nesting = detail::nest_components(
-            comp, static_cast<std::uint32_t>(num_comp), closed, [&](std::uint32_t f) {
+            comp, static_cast<std::uint32_t>(num_comp), closed, tol, [&](std::uint32_t f) {
                 return std::array<Vec3, 3>{vpos[corner[3 * std::size_t{f}]],
                                            vpos[corner[3 * std::size_t{f} + 1]],
                                            vpos[corner[3 * std::size_t{f} + 2]]};
             });
         rep.nesting_unchecked = !nesting.complete;
+        rep.crossing_unchecked = !nesting.crossing_complete;
+        std::vector<std::uint8_t> crosses(num_comp, 0);
+        for (const auto& [a, b] : nesting.crossing) crosses[a] = crosses[b] = 1;
+        rep.crossing_components =
+            static_cast<std::uint64_t>(std::count(crosses.begin(), crosses.end(), 1));
         std::vector<std::uint8_t> turn(num_comp, 0);
         for (std::size_t c = 0; c < num_comp; ++c) {
             if (open[c]) continue;

@@ -173,15 +173,18 @@ ComponentNesting component_nesting(const Mesh& mesh) {
     out.components = face_components(mesh);
     const Components& c = out.components;
     const auto count = static_cast<std::uint32_t>(c.count());
-    detail::Nesting n = detail::nest_components(c.of_face, count, c.closed, [&](std::uint32_t f) {
-        return std::array<Vec3, 3>{mesh.position(mesh.vertex(FaceId(f), 0)),
-                                   mesh.position(mesh.vertex(FaceId(f), 1)),
-                                   mesh.position(mesh.vertex(FaceId(f), 2))};
-    });
+    detail::Nesting n =
+        detail::nest_components(c.of_face, count, c.closed, 0.0, [&](std::uint32_t f) {
+            return std::array<Vec3, 3>{mesh.position(mesh.vertex(FaceId(f), 0)),
+                                       mesh.position(mesh.vertex(FaceId(f), 1)),
+                                       mesh.position(mesh.vertex(FaceId(f), 2))};
+        });
     static_assert(ComponentNesting::kNone == detail::kNotNested);
     out.parent = std::move(n.parent);
     out.depth = std::move(n.depth);
     out.complete = n.complete;
+    out.crossing = std::move(n.crossing);
+    out.crossing_complete = n.crossing_complete;
     return out;
 }
 

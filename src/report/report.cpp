@@ -48,6 +48,15 @@ std::vector<std::string> make_warnings(const InfoReport& r) {
             "too many components to check which lies inside which: a cavity's shell, if any, "
             "is turned outward and the volume counts it as material");
     }
+    if (r.heal.crossing_components) {
+        w.push_back(n(r.heal.crossing_components) +
+                    " closed components cross one another (parts overlapping without their "
+                    "union): each stays a solid of its own, and the volume counts the overlap "
+                    "twice");
+    }
+    if (r.heal.crossing_unchecked) {
+        w.push_back("too many facets lie near one another to check which components cross");
+    }
     if (r.heal.nonmanifold_edges)
         w.push_back(n(r.heal.nonmanifold_edges) + " non-manifold edges split");
     if (r.heal.nonmanifold_vertices) {
@@ -147,6 +156,8 @@ nlohmann::json info_json(const InfoReport& r) {
                     {"cavities", h.cavities},
                     {"cavities_turned_inward", h.cavities_turned_inward},
                     {"nesting_checked", !h.nesting_unchecked},
+                    {"crossing_components", h.crossing_components},
+                    {"crossing_checked", !h.crossing_unchecked},
                     {"facets_split_at_t_junctions", h.facets_split_at_t_junctions},
                     {"holes_filled", h.holes_filled},
                     {"hole_facets_added", h.hole_facets_added},
