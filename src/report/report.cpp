@@ -51,8 +51,9 @@ std::vector<std::string> make_warnings(const InfoReport& r) {
     if (r.heal.crossing_components) {
         w.push_back(n(r.heal.crossing_components) +
                     " closed components cross one another (parts overlapping without their "
-                    "union): each stays a solid of its own, and the volume counts the overlap "
-                    "twice");
+                    "union, or fitted into each other with facets that cut in, as a pin in its "
+                    "hole tessellated apart): each stays a solid of its own, and the volume "
+                    "counts the overlap twice");
     }
     if (r.heal.crossing_unchecked) {
         w.push_back("too many facets lie near one another to check which components cross");
