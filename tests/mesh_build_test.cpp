@@ -259,6 +259,24 @@ TEST(MeshBuild, PartsThatCrossAreFoundAndNeverNested) {
     }
 }
 
+// Too many overlapping components to check which cross within kCrossingWork (two thousand
+// cubes over one another: two million pairs of 24 facets): none is counted, and the report says
+// the check was not made. Nesting is still checked (no box lies in another).
+TEST(MeshBuild, TooManyCrossingComponentsAreNotChecked) {
+    test::Indexed m;
+    for (int k = 0; k < 2000; ++k) {
+        const double d = 0.001 * k;  // along the diagonal: no shared vertex, no common plane
+        m = test::merge(m, test::cube({d, d, d}, 1.0));
+    }
+    const BuildResult b = build_ok(test::to_indexed_soup(m));
+    EXPECT_TRUE(b.heal.crossing_unchecked);
+    EXPECT_EQ(b.heal.crossing_components, 0u);
+    EXPECT_FALSE(b.heal.nesting_unchecked);
+    const ComponentNesting n = component_nesting(b.mesh);
+    EXPECT_FALSE(n.crossing_complete);
+    EXPECT_TRUE(n.crossing.empty());
+}
+
 // Too many components to tell which lies inside which within kNestingWork (a ball of 20k
 // facets round a thousand small cubes, each to be tested against it): no ray is cast, every
 // closed component is turned outward, and the report says the check was not made.

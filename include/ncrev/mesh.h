@@ -178,8 +178,8 @@ struct HealReport {
     /// their union (healing joins none). Each stays a whole closed component, and the volume
     /// counts their overlap twice.
     std::uint64_t crossing_components = 0;
-    /// Too many facet pairs near one another to check which components cross
-    /// (detail::kNestingWork): none is counted.
+    /// Too many components whose boxes meet, too large, to check which cross
+    /// (detail::kCrossingWork): none is counted.
     bool crossing_unchecked = false;
     std::uint64_t nonmanifold_edges = 0;     ///< edges with more than two facets (then split)
     std::uint64_t nonmanifold_vertices = 0;  ///< vertices with more than one fan (then split)

@@ -31,6 +31,17 @@ inline constexpr std::uint64_t kNestingWork = 300'000'000;
 
 inline constexpr std::uint32_t kNotNested = 0xffffffffu;
 
+/// The crossing check's work at most, in facets scanned and facet pairs tested, summed over
+/// the pairs of components whose boxes meet, counted before each pair is compared: a bound of a
+/// few seconds. A ball of 2M facets with a cavity just under its surface counts 2M + 8 x 2M
+/// (0.9 s, docs/benchmarks.md). A thousand cubes over one another in their faces' planes, half a
+/// million pairs of 12 x 12 facets whose edges meet the others' borders (each asking which side
+/// its ends are on), reach it after 3.9 s and are left unchecked (8.3 s to check them all).
+inline constexpr std::uint64_t kCrossingWork = 30'000'000;
+/// Facet pairs a tree hands out per facet, about, when both sides are large: a facet's box
+/// meets those of a few facets of the other side, where the two lie close.
+inline constexpr std::uint64_t kCandidatesPerFacet = 8;
+
 /// Points nearer each other than this share of the closed components' size count as touching
 /// when no tolerance larger is given: about eight float32 rounding steps at the model's size, as
 /// the weld's default tolerance (a vertex of one part lying on a face of another, written in
@@ -81,7 +92,8 @@ struct Nesting {
     /// Pairs (a < b) of closed components whose surfaces cross (meshes of parts overlapping
     /// without their union), sorted. Neither lies inside the other.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
-    /// False when the work bound stopped the crossing check: then no pair is listed.
+    /// False when the work bound (kCrossingWork) stopped the crossing check: then no pair is
+    /// listed.
     bool crossing_complete = true;
 };
 
@@ -91,8 +103,8 @@ struct Nesting {
 /// inside by the parity of rays, as nesting tests). Parts that only touch (a face on a face, an
 /// edge along a face or across an edge) do not cross. `pairs`: the pairs whose boxes meet; of
 /// each, only the facets within both boxes are compared (one side's through a tree of the
-/// other's). Empty, with `complete` false, when the facets to compare, summed over the pairs,
-/// pass kNestingWork.
+/// other's), stopping at the first crossing. The work is counted before each pair is compared
+/// (kCrossingWork): past it, `complete` is false and no pair is listed.
 template <class Corners>
 std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
     std::span<const std::uint32_t> component, std::uint32_t count,
@@ -157,15 +169,21 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
         const bool q_in = in(q, c, q_off);
         return q_off && p_in != q_in;
     };
-    // The facets compared, a bound on the work fixed before any is (the same on every run).
-    std::uint64_t work = 0;
-    for (const auto& [a, b] : pairs) {
-        work += facets[a].size() + facets[b].size();
-        if (work > kNestingWork) {
-            complete = false;
-            return {};
+    // Whether triangle u lies wholly on one side of t's plane, each corner more than tol off
+    // it: then no edge of either passes through the other (most pairs a tree hands out).
+    const auto apart = [&](const Triangle& u, const Triangle& t) {
+        const Vec3 n = cross(t[1] - t[0], t[2] - t[0]);
+        const double len = norm(n);
+        if (!(len > 0)) return true;
+        int above = 0, below = 0;
+        for (const Vec3& v : u) {
+            const double d = dot(v - t[0], n) / len;
+            above += d > tol;
+            below += d < -tol;
         }
-    }
+        return above == 3 || below == 3;
+    };
+    std::uint64_t work = 0;
     for (const auto& [a, b] : pairs) {
         // Where the two boxes overlap.
         Box3 both;
@@ -180,6 +198,15 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
         for (std::size_t side = 0; side < 2; ++side) {
             for (const std::uint32_t f : facets[side == 0 ? a : b])
                 if (meets(box_of(corners(f)), both)) near[side].push_back(f);
+        }
+        // The scan, and the facet pairs the tree may hand out: every pair when the sides are
+        // small (two cubes over each other), a few per facet when they are large.
+        const std::uint64_t na = near[0].size(), nb = near[1].size();
+        work += facets[a].size() + facets[b].size() +
+                std::min(na * nb, kCandidatesPerFacet * (na + nb));
+        if (work > kCrossingWork) {
+            complete = false;
+            return {};
         }
         if (near[0].empty() || near[1].empty()) continue;
         const bool tree_a = near[0].size() < near[1].size();
@@ -199,6 +226,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
                     const Triangle u = corners(asking[i]);
                     bool hit = false;
                     tree.for_each_near(grown(box_of(u)), [&](std::uint32_t, const Triangle& t) {
+                        if (hit || apart(u, t) || apart(t, u)) return;
                         for (std::size_t k = 0; k < 3 && !hit; ++k) {
                             hit = passes(u[k], u[(k + 1) % 3], t, tc) ||
                                   passes(t[k], t[(k + 1) % 3], u, qc);
@@ -286,10 +314,19 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
         }
         return true;
     };
+    // The pairs' facets, summed, bound the pairs kept (their scan alone would pass the bound).
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-    for (std::uint32_t a = 0; a < count; ++a) {
+    std::uint64_t facets_compared = 0;
+    for (std::uint32_t a = 0; a < count && out.crossing_complete; ++a) {
         for (std::uint32_t b = a + 1; b < count && closed[a]; ++b) {
-            if (closed[b] && meet(box[a], box[b])) pairs.emplace_back(a, b);
+            if (!closed[b] || !meet(box[a], box[b])) continue;
+            facets_compared += size[a] + size[b];
+            if (facets_compared > kCrossingWork) {
+                out.crossing_complete = false;
+                pairs = {};
+                break;
+            }
+            pairs.emplace_back(a, b);
         }
     }
     if (!pairs.empty()) {

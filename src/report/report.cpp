@@ -56,7 +56,8 @@ std::vector<std::string> make_warnings(const InfoReport& r) {
                     "counts the overlap twice");
     }
     if (r.heal.crossing_unchecked) {
-        w.push_back("too many facets lie near one another to check which components cross");
+        w.push_back(
+            "too many large components with meeting boxes to check which cross one another");
     }
     if (r.heal.nonmanifold_edges)
         w.push_back(n(r.heal.nonmanifold_edges) + " non-manifold edges split");
