@@ -381,6 +381,26 @@ TEST(MeshBuild, FillsSmallHolesButNotOpenings) {
     EXPECT_EQ(compute_stats(b.mesh).boundary_loops, 2u);
 }
 
+// A part closed only by its filled hole is reported as the closed part it then is: its cavity
+// is one, turned to face into it, and a part crossing it crosses. (The first build saw the
+// part open, with neither; its report was kept until the forty-fifth session.)
+TEST(MeshBuild, APartClosedByItsFilledHoleHasItsCavitiesAndCrossings) {
+    test::Indexed holed = test::cube({0, 0, 0}, 10);
+    holed.triangles.erase(holed.triangles.begin());  // one facet of the bottom
+    const BuildResult cavity =
+        build_ok(test::to_bucket(test::merge(holed, test::cube({3, 3, 3}, 4))));
+    EXPECT_EQ(cavity.heal.holes_filled, 1u);
+    EXPECT_EQ(cavity.heal.cavities, 1u);
+    EXPECT_EQ(cavity.heal.cavities_turned_inward, 1u);  // given facing out of the cavity
+    EXPECT_EQ(cavity.heal.components_turned_outward, 0u);
+    EXPECT_DOUBLE_EQ(compute_stats(cavity.mesh).volume, 1000.0 - 64.0);
+    const BuildResult crossing =
+        build_ok(test::to_bucket(test::merge(holed, test::cube({5, 5, 5}, 10))));
+    EXPECT_EQ(crossing.heal.holes_filled, 1u);
+    EXPECT_EQ(crossing.heal.crossing_components, 2u);
+    EXPECT_EQ(crossing.heal.cavities, 0u);
+}
+
 // A mesh of some of the components: valid on its own, each face with its input facet.
 TEST(MeshBuild, KeepsWholeComponentsAsAMeshOfTheirOwn) {
     test::Indexed m = test::merge(test::cube({0, 0, 0}, 1.0), test::icosphere(1.0, 1, {5, 0, 0}));

@@ -34,9 +34,10 @@ inline constexpr std::uint32_t kNotNested = 0xffffffffu;
 /// The crossing check's work at most, in facets scanned and facet pairs tested, summed over
 /// the pairs of components whose boxes meet, counted before each pair is compared: a bound of a
 /// few seconds. A ball of 2M facets with a cavity just under its surface counts 2M + 8 x 2M
-/// (0.9 s, docs/benchmarks.md). A thousand cubes over one another in their faces' planes, half a
-/// million pairs of 12 x 12 facets whose edges meet the others' borders (each asking which side
-/// its ends are on), reach it after 3.9 s and are left unchecked (8.3 s to check them all).
+/// (0.9 s, docs/benchmarks.md). A thousand closed cubes over one another in their faces' planes
+/// (scripts/crossing_meshes_stl.py cubes 2000), half a million pairs of 12 x 12 facets whose
+/// edges meet the others' borders (each asking which side its ends are on), reach it after 3.9 s
+/// and are left unchecked (8.3 s to check them all).
 inline constexpr std::uint64_t kCrossingWork = 30'000'000;
 /// Facet pairs a tree hands out per facet, about, when both sides are large: a facet's box
 /// meets those of a few facets of the other side, where the two lie close.
@@ -103,39 +104,17 @@ struct Nesting {
 /// inside by the parity of rays, as nesting tests). Parts that only touch (a face on a face, an
 /// edge along a face or across an edge) do not cross. `pairs`: the pairs whose boxes meet; of
 /// each, only the facets within both boxes are compared (one side's through a tree of the
-/// other's), stopping at the first crossing. The work is counted before each pair is compared
-/// (kCrossingWork): past it, `complete` is false and no pair is listed.
+/// other's), stopping at the first crossing. `facets[c]`: component c's facets (for every c of
+/// a pair). The work is counted before each pair is compared (kCrossingWork): past it,
+/// `complete` is false and no pair is listed.
 template <class Corners>
 std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
-    std::span<const std::uint32_t> component, std::uint32_t count,
+    std::span<const std::vector<std::uint32_t>> facets,
     std::span<const std::pair<std::uint32_t, std::uint32_t>> pairs, std::span<const Box3> box,
     double tol, const Corners& corners, bool& complete) {
     using Pair = std::pair<std::uint32_t, std::uint32_t>;
     std::vector<Pair> out;
-    std::vector<std::vector<std::uint32_t>> facets(count);
-    {
-        std::vector<std::uint8_t> used(count, 0);
-        for (const auto& [a, b] : pairs) used[a] = used[b] = 1;
-        for (std::uint32_t f = 0; f < component.size(); ++f)
-            if (used[component[f]]) facets[component[f]].push_back(f);
-    }
-    const auto grown = [&](Box3 b) {
-        for (int k = 0; k < 3; ++k) b.min[k] -= tol, b.max[k] += tol;
-        return b;
-    };
-    const auto meets = [](const Box3& a, const Box3& b) {
-        for (int k = 0; k < 3; ++k)
-            if (a.max[k] < b.min[k] || b.max[k] < a.min[k]) return false;
-        return true;
-    };
-    const auto box_of = [](const Triangle& t) {
-        Box3 b;
-        for (int k = 0; k < 3; ++k) {
-            b.min[k] = std::min({t[0][k], t[1][k], t[2][k]});
-            b.max[k] = std::max({t[0][k], t[1][k], t[2][k]});
-        }
-        return b;
-    };
+    const std::size_t count = facets.size();
     // A whole component's tree, made when a segment through a facet's border asks whether its
     // ends are in that component (rare: symmetric parts).
     std::vector<std::unique_ptr<TriangleTree>> whole(count);
@@ -151,11 +130,10 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
                 whole[c] = std::make_unique<TriangleTree>(std::move(tris));
             });
         });
-        const auto all = [](std::uint32_t) { return true; };
         off = whole[c]->distance(p) > tol;
         if (!off) return false;
         int odd = 0;
-        for (const Vec3& d : rays) odd += static_cast<int>(whole[c]->ray_hits_if(p, d, all) % 2);
+        for (const Vec3& d : rays) odd += static_cast<int>(whole[c]->ray_hits(p, d) % 2);
         return 2 * odd > static_cast<int>(rays.size());
     };
     // Whether segment pq of one component passes into or out of component c through t, one of
@@ -191,13 +169,13 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
             both.min[k] = std::max(box[a].min[k], box[b].min[k]);
             both.max[k] = std::min(box[a].max[k], box[b].max[k]);
         }
-        both = grown(both);
+        both = grown(both, tol);
         // The facets of each side within both boxes; the tree over the smaller side (copies of
         // its triangles), the other side's facets ask it.
         std::array<std::vector<std::uint32_t>, 2> near;
         for (std::size_t side = 0; side < 2; ++side) {
             for (const std::uint32_t f : facets[side == 0 ? a : b])
-                if (meets(box_of(corners(f)), both)) near[side].push_back(f);
+                if (boxes_meet(box_of(corners(f)), both)) near[side].push_back(f);
         }
         // The scan, and the facet pairs the tree may hand out: every pair when the sides are
         // small (two cubes over each other), a few per facet when they are large.
@@ -220,21 +198,21 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
             return TriangleTree(std::move(tris));
         }();
         std::atomic<bool> found{false};
-        tbb::parallel_for(
-            tbb::blocked_range<std::size_t>(0, asking.size(), 1024), [&](const auto& r) {
-                for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
-                    const Triangle u = corners(asking[i]);
-                    bool hit = false;
-                    tree.for_each_near(grown(box_of(u)), [&](std::uint32_t, const Triangle& t) {
-                        if (hit || apart(u, t) || apart(t, u)) return;
-                        for (std::size_t k = 0; k < 3 && !hit; ++k) {
-                            hit = passes(u[k], u[(k + 1) % 3], t, tc) ||
-                                  passes(t[k], t[(k + 1) % 3], u, qc);
-                        }
-                    });
-                    if (hit) found = true;
-                }
-            });
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, asking.size(), 1024),
+                          [&](const auto& r) {
+                              for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
+                                  const Triangle u = corners(asking[i]);
+                                  bool hit = false;
+                                  tree.for_each_near(grown(box_of(u), tol), [&](const Triangle& t) {
+                                      if (hit || apart(u, t) || apart(t, u)) return;
+                                      for (std::size_t k = 0; k < 3 && !hit; ++k) {
+                                          hit = passes(u[k], u[(k + 1) % 3], t, tc) ||
+                                                passes(t[k], t[(k + 1) % 3], u, qc);
+                                      }
+                                  });
+                                  if (hit) found = true;
+                              }
+                          });
         if (found) out.emplace_back(a, b);
     }
     return out;
@@ -308,18 +286,12 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
     for (std::uint32_t c = 0; c < count; ++c)
         if (closed[c]) all.add(box[c]);
     const double touch = std::max(tol, kTouchShare * all.diagonal());
-    const auto meet = [&](const Box3& a, const Box3& b) {
-        for (int k = 0; k < 3; ++k) {
-            if (a.max[k] + touch < b.min[k] || b.max[k] + touch < a.min[k]) return false;
-        }
-        return true;
-    };
     // The pairs' facets, summed, bound the pairs kept (their scan alone would pass the bound).
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
     std::uint64_t facets_compared = 0;
     for (std::uint32_t a = 0; a < count && out.crossing_complete; ++a) {
         for (std::uint32_t b = a + 1; b < count && closed[a]; ++b) {
-            if (!closed[b] || !meet(box[a], box[b])) continue;
+            if (!closed[b] || !boxes_meet(grown(box[a], touch), box[b])) continue;
             facets_compared += size[a] + size[b];
             if (facets_compared > kCrossingWork) {
                 out.crossing_complete = false;
@@ -329,19 +301,23 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
             pairs.emplace_back(a, b);
         }
     }
+    // The facets of the components either check looks at, listed once.
+    std::vector<std::uint8_t> listed = is_outer;
+    for (const auto& [a, b] : pairs) listed[a] = listed[b] = 1;
+    if (std::find(listed.begin(), listed.end(), 1) == listed.end()) return out;
+    std::vector<std::vector<std::uint32_t>> facets(count);
+    for (std::uint32_t f = 0; f < component.size(); ++f) {
+        if (listed[component[f]]) facets[component[f]].push_back(f);
+    }
     if (!pairs.empty()) {
-        out.crossing = crossing_components(component, count, pairs, box, touch, corners,
-                                           out.crossing_complete);
+        out.crossing =
+            crossing_components<Corners>(facets, pairs, box, touch, corners, out.crossing_complete);
     }
     const auto crossed = [&](std::uint32_t a, std::uint32_t b) {
         return std::binary_search(out.crossing.begin(), out.crossing.end(),
                                   std::pair{std::min(a, b), std::max(a, b)});
     };
     if (std::find(is_outer.begin(), is_outer.end(), 1) == is_outer.end()) return out;
-    std::vector<std::vector<std::uint32_t>> facets(count);
-    for (std::uint32_t f = 0; f < component.size(); ++f) {
-        if (is_outer[component[f]]) facets[component[f]].push_back(f);
-    }
     std::vector<std::vector<std::uint32_t>> around(count);
     for (std::uint32_t a = 0; a < count; ++a) {
         for (std::uint32_t b = 0; b < count && closed[a]; ++b) {

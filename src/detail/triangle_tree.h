@@ -62,6 +62,30 @@ inline bool ray_crosses(Vec3 o, Vec3 d, const Triangle& t) {
     return dot(e2, r) / det > 0;
 }
 
+/// Triangle t's bounding box.
+inline Box3 box_of(const Triangle& t) {
+    Box3 b;
+    for (int k = 0; k < 3; ++k) {
+        b.min[k] = std::min({t[0][k], t[1][k], t[2][k]});
+        b.max[k] = std::max({t[0][k], t[1][k], t[2][k]});
+    }
+    return b;
+}
+
+/// Box b grown by d on every side.
+inline Box3 grown(Box3 b, double d) {
+    for (int k = 0; k < 3; ++k) b.min[k] -= d, b.max[k] += d;
+    return b;
+}
+
+/// Whether boxes a and b share a point.
+inline bool boxes_meet(const Box3& a, const Box3& b) {
+    for (int k = 0; k < 3; ++k) {
+        if (a.max[k] < b.min[k] || b.max[k] < a.min[k]) return false;
+    }
+    return true;
+}
+
 /// Triangles per task of the parallel loops over all of a tree's (their centres, the tree's
 /// reordered copy): each costs a few nanoseconds there, and a task's overhead about a
 /// microsecond, so tasks this large keep it under a percent.
@@ -105,11 +129,8 @@ class TriangleTree {
         tris_ = std::move(sorted);
     }
 
-    std::size_t size() const { return tris_.size(); }
-
-    /// Calls fn(i, t) for the triangles t of every leaf whose box meets `box` (a few triangles
-    /// each: those near it, and perhaps some not), i its index in the vector the tree was made
-    /// of; in the tree's order, the same on every run.
+    /// Calls fn(t) for the triangles t of every leaf whose box meets `box` (a few triangles
+    /// each: those near it, and perhaps some not), in the tree's order: the same on every run.
     template <class Fn>
     void for_each_near(const Box3& box, Fn&& fn) const {
         if (tris_.empty()) return;
@@ -124,19 +145,12 @@ class TriangleTree {
                 stack[top++] = n.first;
                 continue;
             }
-            for (std::uint32_t i = n.first; i < n.first + n.count; ++i) fn(order_[i], tris_[i]);
+            for (std::uint32_t i = n.first; i < n.first + n.count; ++i) fn(tris_[i]);
         }
     }
 
     /// Distance from p to the nearest triangle.
     double distance(Vec3 p) const {
-        return distance_if(p, [](std::uint32_t) { return true; });
-    }
-
-    /// Distance from p to the nearest triangle whose index i (as in for_each_near()) passes
-    /// keep(i); infinite when none does.
-    template <class Keep>
-    double distance_if(Vec3 p, const Keep& keep) const {
         if (tris_.empty()) return 0;
         double best2 = std::numeric_limits<double>::infinity();
         // Each level leaves at most one node on the stack (two pushed, one taken): 64 covers
@@ -149,7 +163,6 @@ class TriangleTree {
             if (box_distance2(n.box, p) >= best2) continue;
             if (n.count > 0) {
                 for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
-                    if (!keep(order_[i])) continue;
                     const Triangle& t = tris_[i];
                     const Vec3 q = closest_on_triangle(p, t[0], t[1], t[2]);
                     best2 = std::min(best2, dot(p - q, p - q));
@@ -165,10 +178,8 @@ class TriangleTree {
         return std::sqrt(best2);
     }
 
-    /// How many triangles whose index passes keep(i) the ray from o along d crosses
-    /// (ray_crosses()).
-    template <class Keep>
-    std::uint64_t ray_hits_if(Vec3 o, Vec3 d, const Keep& keep) const {
+    /// How many triangles the ray from o along d crosses (ray_crosses()).
+    std::uint64_t ray_hits(Vec3 o, Vec3 d) const {
         std::uint64_t hits = 0;
         if (tris_.empty()) return hits;
         std::array<std::uint32_t, 64> stack{};
@@ -183,7 +194,7 @@ class TriangleTree {
                 continue;
             }
             for (std::uint32_t i = n.first; i < n.first + n.count; ++i)
-                hits += keep(order_[i]) && ray_crosses(o, d, tris_[i]);
+                hits += ray_crosses(o, d, tris_[i]);
         }
         return hits;
     }
@@ -199,13 +210,6 @@ class TriangleTree {
         std::uint32_t first = 0;  // leaf: first triangle; inner node: first of two children
         std::uint32_t count = 0;  // triangles of a leaf, 0 for an inner node
     };
-
-    static bool boxes_meet(const Box3& a, const Box3& b) {
-        for (int k = 0; k < 3; ++k) {
-            if (a.max[k] < b.min[k] || b.max[k] < a.min[k]) return false;
-        }
-        return true;
-    }
 
     /// Whether the ray from o along d meets box b (slabs).
     static bool ray_meets_box(Vec3 o, Vec3 d, const Box3& b) {

@@ -995,7 +995,11 @@ std::map<std::uint32_t, std::vector<std::uint32_t>> t_junctions(const Mesh& m, d
 /// and cracks aside): the faces keep their input facets, the added ones have none. The report
 /// is the first build's, with what the second found among the new facets (degenerate ones,
 /// caps, duplicates); its other counts (non-manifold edges and vertices, flips, conflicts)
-/// find the first build's defects again, in its vertices that the exact weld joins again.
+/// find the first build's defects again, in its vertices that the exact weld joins again. What
+/// depends on which components are closed is the second's: a part closed by its filled hole
+/// first gets its cavities and crossings (the first build saw it open, so neither), and the
+/// components it turns are added to the first's. (A cavity's shell given facing in, in a part
+/// with a hole, is turned out by the first build and back in by the second: counted both ways.)
 Result<BuildResult> MeshBuilder::rebuild(
     BuildResult built, const std::map<std::uint32_t, std::vector<std::uint32_t>>& split,
     const std::vector<std::array<std::uint32_t, 3>>& added,
@@ -1047,6 +1051,12 @@ Result<BuildResult> MeshBuilder::rebuild(
     heal.degenerate_facets_removed += second.degenerate_facets_removed;
     heal.caps_split += second.caps_split;
     heal.duplicate_facets_removed += second.duplicate_facets_removed;
+    heal.components_turned_outward += second.components_turned_outward;
+    heal.cavities_turned_inward += second.cavities_turned_inward;
+    heal.cavities = second.cavities;
+    heal.nesting_unchecked = second.nesting_unchecked;
+    heal.crossing_components = second.crossing_components;
+    heal.crossing_unchecked = second.crossing_unchecked;
     rebuilt->heal = std::move(heal);
     return rebuilt;
 }
