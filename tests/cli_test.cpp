@@ -148,6 +148,38 @@ TEST(CliInfo, PartsThatCrossAreReported) {
     std::filesystem::remove(path);
 }
 
+// A cube with a corner pushed through the opposite wall: `info` and `reverse` say the mesh
+// passes through itself, and where; `reverse` still writes what it built.
+TEST(CliInfo, AMeshThatPassesThroughItselfIsReported) {
+    auto m = test::cube({0, 0, 0}, 10.0);
+    for (Vec3& p : m.points)
+        if (p.x == 10 && p.y == 10 && p.z == 10) p = Vec3{-3, 4, 6.5};  // off the diagonals
+    const auto path = write_temp("ncrev_cli_self.stl", encode_stl_binary(m.points, m.triangles));
+    const CliRun r = run("info --json " + path.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_GT(j["healing"]["self_intersections"].get<int>(), 0);
+    EXPECT_EQ(j["healing"]["self_intersection_checked"], true);
+    EXPECT_NEAR(j["healing"]["self_intersection_at"][0].get<double>(), 0.0, 1e-9);  // x = 0 wall
+    EXPECT_NE(r.err.find("the mesh passes through itself"), std::string::npos) << r.err;
+    const auto step = test::scratch_dir() / "ncrev_cli_self.step";
+    const CliRun rev = run("reverse " + path.string() + " -o " + step.string() + " --json");
+    ASSERT_EQ(rev.code, 0) << rev.err;
+    const auto jr = nlohmann::json::parse(rev.out);
+    EXPECT_EQ(jr["healing"]["self_intersections"], j["healing"]["self_intersections"]);
+    bool warned = false;
+    for (const auto& w : jr["warnings"])
+        warned = warned || w.get<std::string>().find("passes through itself") != std::string::npos;
+    EXPECT_TRUE(warned);
+    const auto cube = test::cube();
+    const auto clean_path =
+        write_temp("ncrev_cli_clean.stl", encode_stl_binary(cube.points, cube.triangles));
+    const CliRun clean = run("info --json " + clean_path.string());
+    ASSERT_EQ(clean.code, 0) << clean.err;
+    EXPECT_EQ(nlohmann::json::parse(clean.out)["healing"]["self_intersections"], 0);
+    for (const auto& f : {step, path, clean_path}) std::filesystem::remove(f);
+}
+
 // A ball that lost a facet: healing fills the hole and says so; --keep-holes shows it open.
 TEST(CliInfo, FillsASmallHoleUnlessToldToKeepIt) {
     auto m = test::icosphere(10.0, 3);

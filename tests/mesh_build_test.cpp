@@ -259,6 +259,69 @@ TEST(MeshBuild, PartsThatCrossAreFoundAndNeverNested) {
     }
 }
 
+// A mesh that passes through itself: a ball with one vertex pushed out through the far wall,
+// two facets folded onto each other across their edge, a fan whose third facet comes back
+// through its first. Healing counts the facet pairs that cross and says where the first does,
+// the same on any thread count and in any facet order; it mends none. A ball and a plate
+// thinner than the mesh's resolution (walls close, not crossing) have none.
+TEST(MeshBuild, AMeshThatPassesThroughItselfIsFound) {
+    const test::Indexed ball = test::icosphere(10.0, 4);
+    EXPECT_EQ(build_ok(test::to_bucket(ball)).heal.self_intersections, 0u);
+    test::Indexed plate = test::cube();
+    for (Vec3& p : plate.points) p = Vec3{10 * p.x, 10 * p.y, 1e-3 * p.z};
+    const BuildResult thin = build_ok(test::to_bucket(plate));
+    EXPECT_EQ(thin.heal.self_intersections, 0u);
+    EXPECT_FALSE(thin.heal.self_intersection_unchecked);
+
+    test::Indexed pushed = ball;
+    std::size_t far = 0;
+    for (std::size_t i = 0; i < pushed.points.size(); ++i)
+        if (pushed.points[i].x > pushed.points[far].x) far = i;
+    pushed.points[far] = Vec3{-12, 0.1, 0.2};
+    std::vector<BuildResult> runs;
+    for (const int threads : {1, 2, 4}) {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism,
+                              static_cast<std::size_t>(threads));
+        runs.push_back(build_ok(test::to_bucket(pushed)));
+    }
+    const HealReport& h = runs.front().heal;
+    // The pushed vertex's fan (six facets) crosses the far wall and the facets it passes.
+    EXPECT_GE(h.self_intersections, 6u);
+    EXPECT_FALSE(h.self_intersection_unchecked);
+    EXPECT_LT(norm(h.self_intersection_at), 10.0 + 1e-9);  // inside the ball or on its wall
+    EXPECT_GT(norm(h.self_intersection_at), 1.0);
+    for (const BuildResult& r : runs) {
+        EXPECT_EQ(r.heal.self_intersections, h.self_intersections);
+        EXPECT_EQ(r.heal.self_intersection_at, h.self_intersection_at);
+    }
+    TriangleSoup shuffled = test::to_bucket(pushed);
+    test::permute_facets(shuffled, 7);
+    EXPECT_EQ(build_ok(shuffled).heal.self_intersections, h.self_intersections);
+
+    // Folded: the second facet's third corner on the first's side of their edge, in its plane.
+    test::Indexed fold;
+    fold.points = {{0, 0, 0}, {4, 0, 0}, {1, 3, 0}, {3, 2, 0}};
+    fold.triangles = {{0, 1, 2}, {1, 0, 3}};
+    const BuildResult folded = build_ok(test::to_bucket(fold));
+    EXPECT_EQ(folded.heal.self_intersections, 1u);
+    EXPECT_NEAR(folded.heal.self_intersection_at.x, 7.0 / 3, 1e-6);  // the second's centre
+    EXPECT_NEAR(folded.heal.self_intersection_at.y, 2.0 / 3, 1e-6);
+    // Opened out flat (the corner across the edge), it does not cross.
+    fold.points[3] = {3, -2, 0};
+    EXPECT_EQ(build_ok(test::to_bucket(fold)).heal.self_intersections, 0u);
+
+    // A fan about the origin: the third facet's outer edge passes through the first facet,
+    // which it shares only the origin with.
+    test::Indexed fan;
+    fan.points = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {0.3, 1.2, 1}, {0.7, 0.2, -1}};
+    fan.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}};
+    const BuildResult fanned = build_ok(test::to_bucket(fan));
+    EXPECT_EQ(fanned.heal.self_intersections, 1u);
+    EXPECT_NEAR(fanned.heal.self_intersection_at.x, 0.5, 1e-6);
+    EXPECT_NEAR(fanned.heal.self_intersection_at.y, 0.7, 1e-6);
+    EXPECT_NEAR(fanned.heal.self_intersection_at.z, 0.0, 1e-6);
+}
+
 // Too many overlapping components to check which cross within kCrossingWork (two thousand
 // cubes over one another: two million pairs of 24 facets): none is counted, and the report says
 // the check was not made. Nesting is still checked (no box lies in another).

@@ -181,6 +181,15 @@ struct HealReport {
     /// Too many components whose boxes meet, too large, to check which cross
     /// (detail::kCrossingWork): none is counted.
     bool crossing_unchecked = false;
+    /// Facet pairs of one component that cross each other: the mesh passes through itself (a
+    /// vertex pushed through a wall, a surface folded over its neighbour), and so does any
+    /// solid built from it. Healing mends none; OpenCASCADE's check does not see them.
+    std::uint64_t self_intersections = 0;
+    /// Where the pair of least facet indices crosses (when self_intersections > 0).
+    Vec3 self_intersection_at{};
+    /// Too many facets over one another to check (detail::kSelfIntersectionWork): none is
+    /// counted.
+    bool self_intersection_unchecked = false;
     std::uint64_t nonmanifold_edges = 0;     ///< edges with more than two facets (then split)
     std::uint64_t nonmanifold_vertices = 0;  ///< vertices with more than one fan (then split)
     std::uint64_t orientation_conflicts =

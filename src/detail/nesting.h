@@ -83,6 +83,21 @@ inline Pierce pierces(Vec3 p, Vec3 q, const Triangle& t, double tol) {
     return out;
 }
 
+/// Whether triangle u lies wholly on one side of t's plane, each corner more than `tol` off it:
+/// then no edge of either passes through the other (most pairs a tree hands out).
+inline bool apart(const Triangle& u, const Triangle& t, double tol) {
+    const Vec3 n = cross(t[1] - t[0], t[2] - t[0]);
+    const double len = norm(n);
+    if (!(len > 0)) return true;
+    int above = 0, below = 0;
+    for (const Vec3& v : u) {
+        const double d = dot(v - t[0], n) / len;
+        above += d > tol;
+        below += d < -tol;
+    }
+    return above == 3 || below == 3;
+}
+
 struct Nesting {
     /// Per component: the closed component immediately around it, or kNotNested.
     std::vector<std::uint32_t> parent;
@@ -147,20 +162,6 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
         const bool q_in = in(q, c, q_off);
         return q_off && p_in != q_in;
     };
-    // Whether triangle u lies wholly on one side of t's plane, each corner more than tol off
-    // it: then no edge of either passes through the other (most pairs a tree hands out).
-    const auto apart = [&](const Triangle& u, const Triangle& t) {
-        const Vec3 n = cross(t[1] - t[0], t[2] - t[0]);
-        const double len = norm(n);
-        if (!(len > 0)) return true;
-        int above = 0, below = 0;
-        for (const Vec3& v : u) {
-            const double d = dot(v - t[0], n) / len;
-            above += d > tol;
-            below += d < -tol;
-        }
-        return above == 3 || below == 3;
-    };
     std::uint64_t work = 0;
     for (const auto& [a, b] : pairs) {
         // Where the two boxes overlap.
@@ -204,7 +205,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
                                   const Triangle u = corners(asking[i]);
                                   bool hit = false;
                                   tree.for_each_near(grown(box_of(u), tol), [&](const Triangle& t) {
-                                      if (hit || apart(u, t) || apart(t, u)) return;
+                                      if (hit || apart(u, t, tol) || apart(t, u, tol)) return;
                                       for (std::size_t k = 0; k < 3 && !hit; ++k) {
                                           hit = passes(u[k], u[(k + 1) % 3], t, tc) ||
                                                 passes(t[k], t[(k + 1) % 3], u, qc);

@@ -23,6 +23,7 @@
 #include "detail/exact_weld.h"
 #include "detail/huge_pages.h"
 #include "detail/nesting.h"
+#include "detail/self_intersection.h"
 #include "detail/union_find.h"
 #include "ncrev/mesh.h"
 
@@ -743,6 +744,24 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     } else {
         std::fill(flip.begin(), flip.end(), 0);
     }
+    // Facets of one component that cross each other: reported, not mended.
+    {
+        const detail::SelfIntersections crossed = detail::self_intersections(
+            comp, tol,
+            [&](std::uint32_t f) {
+                return std::array<Vec3, 3>{vpos[corner[3 * std::size_t{f}]],
+                                           vpos[corner[3 * std::size_t{f} + 1]],
+                                           vpos[corner[3 * std::size_t{f} + 2]]};
+            },
+            [&](std::uint32_t f) {
+                return std::array<std::uint32_t, 3>{corner[3 * std::size_t{f}],
+                                                    corner[3 * std::size_t{f} + 1],
+                                                    corner[3 * std::size_t{f} + 2]};
+            });
+        rep.self_intersections = crossed.pairs;
+        rep.self_intersection_at = crossed.at;
+        rep.self_intersection_unchecked = !crossed.complete;
+    }
     comp = {};
     report_progress("orient", 1.0);
 
@@ -1057,6 +1076,9 @@ Result<BuildResult> MeshBuilder::rebuild(
     heal.nesting_unchecked = second.nesting_unchecked;
     heal.crossing_components = second.crossing_components;
     heal.crossing_unchecked = second.crossing_unchecked;
+    heal.self_intersections = second.self_intersections;
+    heal.self_intersection_at = second.self_intersection_at;
+    heal.self_intersection_unchecked = second.self_intersection_unchecked;
     rebuilt->heal = std::move(heal);
     return rebuilt;
 }

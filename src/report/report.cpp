@@ -59,6 +59,20 @@ std::vector<std::string> make_warnings(const InfoReport& r) {
         w.push_back(
             "too many large components with meeting boxes to check which cross one another");
     }
+    if (r.heal.self_intersections) {
+        const Vec3 at = r.heal.self_intersection_at;
+        char where[96];
+        std::snprintf(where, sizeof where, "(%.6g, %.6g, %.6g)", at.x, at.y, at.z);
+        w.push_back("the mesh passes through itself: " + n(r.heal.self_intersections) +
+                    " pairs of facets cross, the first near " + where +
+                    " (a vertex pushed through a wall, a surface folded over its neighbour); a "
+                    "solid built from it intersects itself too, which CAD systems reject");
+    }
+    if (r.heal.self_intersection_unchecked) {
+        w.push_back(
+            "too many facets over one another to check whether the mesh passes "
+            "through itself");
+    }
     if (r.heal.nonmanifold_edges)
         w.push_back(n(r.heal.nonmanifold_edges) + " non-manifold edges split");
     if (r.heal.nonmanifold_vertices) {
@@ -160,12 +174,15 @@ nlohmann::json info_json(const InfoReport& r) {
                     {"nesting_checked", !h.nesting_unchecked},
                     {"crossing_components", h.crossing_components},
                     {"crossing_checked", !h.crossing_unchecked},
+                    {"self_intersections", h.self_intersections},
+                    {"self_intersection_checked", !h.self_intersection_unchecked},
                     {"facets_split_at_t_junctions", h.facets_split_at_t_junctions},
                     {"holes_filled", h.holes_filled},
                     {"hole_facets_added", h.hole_facets_added},
                     {"nonmanifold_edges", h.nonmanifold_edges},
                     {"nonmanifold_vertices", h.nonmanifold_vertices},
                     {"orientation_conflicts", h.orientation_conflicts}};
+    if (h.self_intersections) j["healing"]["self_intersection_at"] = vec(h.self_intersection_at);
     const MeshStats& m = r.mesh;
     json bbox = m.bbox.empty() ? json::array({vec({}), vec({})})
                                : json::array({vec(m.bbox.min), vec(m.bbox.max)});
