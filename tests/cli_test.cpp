@@ -149,7 +149,8 @@ TEST(CliInfo, PartsThatCrossAreReported) {
 }
 
 // A cube with a corner pushed through the opposite wall: `info` and `reverse` say the mesh
-// passes through itself, and where; `reverse` still writes what it built.
+// passes through itself, and where; `reverse` still writes what it built, unless told to
+// write solids only.
 TEST(CliInfo, AMeshThatPassesThroughItselfIsReported) {
     auto m = test::cube({0, 0, 0}, 10.0);
     for (Vec3& p : m.points)
@@ -171,6 +172,13 @@ TEST(CliInfo, AMeshThatPassesThroughItselfIsReported) {
     for (const auto& w : jr["warnings"])
         warned = warned || w.get<std::string>().find("passes through itself") != std::string::npos;
     EXPECT_TRUE(warned);
+    std::filesystem::remove(step);
+    // Not a solid a CAD system takes: --require-solid writes nothing.
+    const CliRun required =
+        run("reverse " + path.string() + " -o " + step.string() + " --require-solid");
+    EXPECT_EQ(required.code, 3) << required.err;
+    EXPECT_NE(required.err.find("passes through itself"), std::string::npos) << required.err;
+    EXPECT_FALSE(std::filesystem::exists(step));
     const auto cube = test::cube();
     const auto clean_path =
         write_temp("ncrev_cli_clean.stl", encode_stl_binary(cube.points, cube.triangles));

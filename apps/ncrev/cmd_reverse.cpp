@@ -88,7 +88,8 @@ void add_reverse(CLI::App& app, Context& ctx) {
     cmd->add_flag(
         "--require-solid", o->require_solid,
         "Fail (exit 3, nothing written) unless the result is closed solids (an open mesh's "
-        "closed components are, with auto and surfaces, when they are most of it)");
+        "closed components are, with auto and surfaces, when they are most of it) and the mesh "
+        "does not pass through itself");
     cmd->add_flag("--json", o->json, "Print the report (as --report writes it) on stdout");
     cmd->add_flag("-q,--quiet", o->quiet, "No warnings and no progress on stderr");
     cmd->callback([o, &ctx]() {
@@ -114,6 +115,17 @@ void add_reverse(CLI::App& app, Context& ctx) {
                               ": written as STEP whatever its name; CAD systems look for "
                               ".step or .stp");
             }
+        }
+        // Whatever is built from a mesh through itself passes through itself too: no solid a CAD
+        // system takes, which --require-solid asks for.
+        if (o->require_solid && healed->report.heal.self_intersections > 0) {
+            if (!o->quiet)
+                for (const std::string& w : healed->report.warnings) print_warning(w);
+            print_error(o->input +
+                        ": the mesh passes through itself: no valid solid, nothing written "
+                        "(--require-solid)");
+            ctx.exit_code = kExitNoResult;
+            return;
         }
         const auto progress = terminal_progress(ctx, o->quiet);
         ReverseOptions ro;
@@ -196,6 +208,7 @@ void add_reverse(CLI::App& app, Context& ctx) {
                 bodies += " with " + std::to_string(rev->voids) +
                           (rev->voids > 1 ? " cavities" : " cavity");
             }
+            if (healed->report.heal.self_intersections > 0) bodies += " passing through itself";
             std::fprintf(stderr, "%s: %llu faces (%s), %llu edges, %llu vertices, %s, %llu bytes\n",
                          o->output.c_str(), static_cast<unsigned long long>(rev->faces),
                          kinds.c_str(), static_cast<unsigned long long>(rev->edges),
