@@ -260,10 +260,11 @@ TEST(MeshBuild, PartsThatCrossAreFoundAndNeverNested) {
 }
 
 // A mesh that passes through itself: a ball with one vertex pushed out through the far wall,
-// two facets folded onto each other across their edge, a fan whose third facet comes back
-// through its first. Healing counts the facet pairs that cross and says where the first does,
-// the same on any thread count and in any facet order; it mends none. A ball and a plate
-// thinner than the mesh's resolution (walls close, not crossing) have none.
+// a cube's corner pushed through the opposite wall's diagonal, two facets folded onto each
+// other across their edge, a fan whose third facet comes back through its first. Healing counts the
+// facet pairs that cross and says where the first does, the same on any thread count and in any
+// facet order; it mends none. A ball and a plate thinner than the mesh's resolution (walls close,
+// not crossing) have none.
 TEST(MeshBuild, AMeshThatPassesThroughItselfIsFound) {
     const test::Indexed ball = test::icosphere(10.0, 4);
     EXPECT_EQ(build_ok(test::to_bucket(ball)).heal.self_intersections, 0u);
@@ -297,6 +298,17 @@ TEST(MeshBuild, AMeshThatPassesThroughItselfIsFound) {
     TriangleSoup shuffled = test::to_bucket(pushed);
     test::permute_facets(shuffled, 7);
     EXPECT_EQ(build_ok(shuffled).heal.self_intersections, h.self_intersections);
+
+    // A cube's corner pushed straight through the diagonal of the opposite wall: the edges that
+    // cross pass through the border between the wall's two facets (told by the wedge those
+    // make). Pushed in but not through, or onto the wall, it does not cross.
+    for (const auto& [to, crosses] :
+         {std::pair{Vec3{-3, 5, 5}, true}, std::pair{Vec3{3, 5, 5}, false},
+          std::pair{Vec3{0, 5, 5}, false}}) {
+        test::Indexed corner = test::cube({0, 0, 0}, 10);
+        corner.points[7] = to;  // was (10, 10, 10)
+        EXPECT_EQ(build_ok(test::to_bucket(corner)).heal.self_intersections > 0, crosses) << to.x;
+    }
 
     // Folded: the second facet's third corner on the first's side of their edge, in its plane.
     test::Indexed fold;

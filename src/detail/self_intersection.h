@@ -23,11 +23,11 @@
 
 namespace ncrev::detail {
 
-/// Facet pairs the tree hands out at most, summed over all facets, before the check gives up:
-/// a bound of a few seconds. A mesh of a machined part gets a few dozen per facet (its leaves
-/// hold kLeafTriangles each, and a facet's box meets those of its fan and the next ring): a
-/// ball of 2M facets 38M (docs/benchmarks.md). A pile of facets over one another in one place
-/// would otherwise cost facets squared.
+/// Facet pairs whose boxes meet, as the tree's search hands them out, at most, before the check
+/// gives up: a bound of some ten seconds. A mesh of a machined part has about a dozen per facet
+/// (a facet's box meets those of its fans and a few more): 24M on a ball of 2M facets, 1.1 s
+/// (docs/benchmarks.md). A pile of facets over one another in one place would otherwise cost
+/// facets squared.
 inline constexpr std::uint64_t kSelfIntersectionWork = 400'000'000;
 
 /// Pairs a task counts before it adds them to the shared count (and learns whether to stop).
@@ -54,21 +54,73 @@ inline Vec3 plane_crossing(Vec3 p, Vec3 q, const Triangle& t) {
     return p + (dp / (dp - dq)) * (q - p);
 }
 
+/// Whether segment pq, which passes within `tol` of the border of facet b (index bi), crosses
+/// the surface there (`at`: where). Only through an edge, within `tol` of one of b's edges and
+/// clear of the others (through a corner it is not counted), and one with a facet across it
+/// (`across(bi, k, ci, c, ids)`: the facet ci across b's edge k, from corner k to k + 1, its
+/// corners c and vertex ids, both facets turned as the mesh's orientation has them). The two
+/// facets make a wedge, open (convex: c's middle below b's plane) or closed; pq crosses when
+/// one end lies outside the wedge and the other inside, each by more than `tol`: an edge that
+/// only grazes a convex edge has both ends outside. Counted on the facet of lower index of the
+/// two, or on b when pq's facet (vertex ids `ids_pq`) shares a corner with c (its pair with c
+/// is tested otherwise).
+template <class Across>
+bool crosses_border(Vec3 p, Vec3 q, const Triangle& b, std::uint32_t bi,
+                    const std::array<std::uint32_t, 3>& ids_pq, const Across& across, double tol,
+                    Vec3& at) {
+    Vec3 n1 = cross(b[1] - b[0], b[2] - b[0]);
+    const double len = norm(n1);
+    if (!(len > 0)) return false;
+    n1 = (1 / len) * n1;
+    const Vec3 x = plane_crossing(p, q, b);
+    int edge = -1;
+    for (std::size_t k = 0; k < 3; ++k) {
+        const Vec3 e = b[(k + 1) % 3] - b[k];
+        const double le = norm(e);
+        if (!(le > 0)) return false;
+        if (dot(cross(e, x - b[k]), n1) / le > tol) continue;
+        if (edge >= 0) return false;  // near a corner
+        edge = static_cast<int>(k);
+    }
+    std::uint32_t ci = kNoFacet;
+    Triangle c;
+    std::array<std::uint32_t, 3> ids_c{};
+    if (edge < 0 || !across(bi, edge, ci, c, ids_c)) return false;
+    bool shares = false;
+    for (const std::uint32_t v : ids_pq)
+        shares = shares || std::find(ids_c.begin(), ids_c.end(), v) != ids_c.end();
+    if (!(bi < ci) && !shares) return false;
+    Vec3 n2 = cross(c[1] - c[0], c[2] - c[0]);
+    const double len2 = norm(n2);
+    if (!(len2 > 0)) return false;
+    n2 = (1 / len2) * n2;
+    const Vec3 a = b[static_cast<std::size_t>(edge)];
+    const bool convex = dot((1.0 / 3) * (c[0] + c[1] + c[2]) - a, n1) < 0;
+    // How far outside the wedge (negative: inside).
+    const auto outside = [&](Vec3 v) {
+        const double s1 = dot(v - a, n1), s2 = dot(v - a, n2);
+        return convex ? std::max(s1, s2) : std::min(s1, s2);
+    };
+    const double op = outside(p), oq = outside(q);
+    if (!((op > tol && oq < -tol) || (op < -tol && oq > tol))) return false;
+    at = x;
+    return true;
+}
+
 /// Whether two facets of one component cross, and where: `u`, `t` their corners, `iu`, `it`
-/// their vertex ids. Sharing no vertex: an edge of one passes through the other more than
-/// `tol` inside it (pierces(), kThrough). An edge through a border between facets (kBorder)
-/// does not count: it may only graze a convex edge, and telling needs the facets around it.
-/// Where a part crosses itself, most of its crossing edges pass through facets; only a crossing
-/// whose every edge meets borders (a cube's corner pushed straight through the diagonal of the
-/// opposite wall) is missed. Sharing one vertex: the edge of one opposite that vertex
-/// passes through the other (where two facets of a fan overlap, the line they share through
-/// the vertex leaves the nearer one through that edge). Sharing an edge: folded onto each
-/// other, the third corner of one in the other's plane within `tol` and on the same side of
-/// the edge by more than `tol`. Facets that only touch (a wall within `tol` of another, an
-/// edge along a facet) do not cross.
-inline bool facets_cross(const Triangle& u, const std::array<std::uint32_t, 3>& iu,
-                         const Triangle& t, const std::array<std::uint32_t, 3>& it, double tol,
-                         Vec3& at) {
+/// their vertex ids, `ui`, `ti` their indices. Sharing no vertex: an edge of one passes through
+/// the other, more than `tol` inside it (pierces(), kThrough), or through its border where the
+/// surface is crossed there (crosses_border(), with `across`: a part's corner pushed straight
+/// through the diagonal of the opposite wall). Sharing one vertex: the edge of one opposite
+/// that vertex passes through the other likewise (where two facets of a fan overlap, the line
+/// they share through the vertex leaves the nearer one through that edge). Sharing an edge:
+/// folded onto each other, the third corner of one in the other's plane within `tol` and on
+/// the same side of the edge by more than `tol`. Facets that only touch (a wall within `tol` of
+/// another, an edge along a facet, across an edge) do not cross.
+template <class Across>
+bool facets_cross(const Triangle& u, const std::array<std::uint32_t, 3>& iu, std::uint32_t ui,
+                  const Triangle& t, const std::array<std::uint32_t, 3>& it, std::uint32_t ti,
+                  const Across& across, double tol, Vec3& at) {
     int shared = 0;
     std::array<bool, 3> u_shared{}, t_shared{};
     for (std::size_t i = 0; i < 3; ++i) {
@@ -80,8 +132,12 @@ inline bool facets_cross(const Triangle& u, const std::array<std::uint32_t, 3>& 
     }
     // Edge k of a triangle runs from corner k to corner k + 1.
     const auto through = [&](const Triangle& a, std::size_t k, const Triangle& b) {
+        const bool from_u = &a == &u;
         const Vec3 p = a[k], q = a[(k + 1) % 3];
-        if (pierces(p, q, b, tol) != Pierce::kThrough) return false;
+        const Pierce how = pierces(p, q, b, tol);
+        if (how == Pierce::kBorder)
+            return crosses_border(p, q, b, from_u ? ti : ui, from_u ? iu : it, across, tol, at);
+        if (how != Pierce::kThrough) return false;
         at = plane_crossing(p, q, b);
         return true;
     };
@@ -122,14 +178,15 @@ inline bool facets_cross(const Triangle& u, const std::array<std::uint32_t, 3>& 
 }
 
 /// The facet pairs of one component (`component[f]`) that cross (facets_cross()), counted
-/// each once: `corners(f)` facet f's three points, `ids(f)` their vertex ids, `tol` the distance
+/// each once: `corners(f)` facet f's three points, `ids(f)` their vertex ids (both in the
+/// order the mesh's orientation gives), `across` as crosses_border() asks it, `tol` the distance
 /// within which points touch (at least kTouchShare of the mesh's size). Facets of different
 /// components are not compared: closed ones that cross are crossing_components()'s. A tree of
 /// all facets hands each facet those whose boxes may meet its own; past kSelfIntersectionWork
 /// of them the check stops, incomplete. Deterministic on any thread count.
-template <class Corners, class Ids>
+template <class Corners, class Ids, class Across>
 SelfIntersections self_intersections(std::span<const std::uint32_t> component, double tol,
-                                     const Corners& corners, const Ids& ids) {
+                                     const Corners& corners, const Ids& ids, const Across& across) {
     SelfIntersections out;
     const std::size_t nf = component.size();
     if (nf < 2) return out;
@@ -175,7 +232,8 @@ SelfIntersections self_intersections(std::span<const std::uint32_t> component, d
         if (tree.index(b) < tree.index(a)) std::swap(a, b);
         const std::uint32_t f = tree.index(a), g = tree.index(b);
         Vec3 at;
-        if (!facets_cross(tree.triangle(a), ids_at[a], tree.triangle(b), ids_at[b], tol, at))
+        if (!facets_cross(tree.triangle(a), ids_at[a], f, tree.triangle(b), ids_at[b], g, across,
+                          tol, at))
             return true;
         ++mine.found;
         if (mine.first == kNoFacet || f < mine.first || (f == mine.first && g < mine.second)) {

@@ -744,20 +744,34 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     } else {
         std::fill(flip.begin(), flip.end(), 0);
     }
-    // Facets of one component that cross each other: reported, not mended.
+    // Facets of one component that cross each other: reported, not mended. Each facet as the
+    // orientation turns it (flip: v0 v1 v2 -> v0 v2 v1, its edge in slot i to slot 2 - i), so
+    // that facets across an edge agree on their sides (crossings through a border are told by
+    // the wedge the two make; none where nothing was oriented).
     {
-        const detail::SelfIntersections crossed = detail::self_intersections(
-            comp, tol,
-            [&](std::uint32_t f) {
-                return std::array<Vec3, 3>{vpos[corner[3 * std::size_t{f}]],
-                                           vpos[corner[3 * std::size_t{f} + 1]],
-                                           vpos[corner[3 * std::size_t{f} + 2]]};
-            },
-            [&](std::uint32_t f) {
-                return std::array<std::uint32_t, 3>{corner[3 * std::size_t{f}],
-                                                    corner[3 * std::size_t{f} + 1],
-                                                    corner[3 * std::size_t{f} + 2]};
-            });
+        const auto ids = [&](std::uint32_t f) {
+            const std::size_t h = 3 * std::size_t{f};
+            return flip[f] ? std::array<std::uint32_t, 3>{corner[h], corner[h + 2], corner[h + 1]}
+                           : std::array<std::uint32_t, 3>{corner[h], corner[h + 1], corner[h + 2]};
+        };
+        const auto corners = [&](std::uint32_t f) {
+            const std::array<std::uint32_t, 3> v = ids(f);
+            return std::array<Vec3, 3>{vpos[v[0]], vpos[v[1]], vpos[v[2]]};
+        };
+        const auto across = [&](std::uint32_t f, int k, std::uint32_t& g,
+                                std::array<Vec3, 3>& other, std::array<std::uint32_t, 3>& vids) {
+            if (!options.orient) return false;
+            const std::uint32_t slot =
+                flip[f] ? 2 - static_cast<std::uint32_t>(k) : static_cast<std::uint32_t>(k);
+            const std::uint32_t m = mate[3 * std::size_t{f} + slot];
+            if (m == kNone) return false;
+            g = m / 3;
+            other = corners(g);
+            vids = ids(g);
+            return true;
+        };
+        const detail::SelfIntersections crossed =
+            detail::self_intersections(comp, tol, corners, ids, across);
         rep.self_intersections = crossed.pairs;
         rep.self_intersection_at = crossed.at;
         rep.self_intersection_unchecked = !crossed.complete;
