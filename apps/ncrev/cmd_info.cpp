@@ -22,8 +22,9 @@ void add_info(CLI::App& app, Context& ctx) {
         "info",
         "Read a mesh (STL ASCII or binary, SRE), heal it, and report what was read and what "
         "healing did: welded vertices, degenerate, duplicate and flipped facets, non-manifold "
-        "edges and vertices, components, boundary loops (holes), Euler characteristic, area, "
-        "volume, bounding box.");
+        "edges and vertices, holes closed, components, cavities, parts that cross each other, "
+        "facets that cross (the mesh passing through itself, and where), boundary loops "
+        "(holes), Euler characteristic, area, volume, bounding box.");
     cmd->add_option("FILE", opts->path, "Mesh file: .stl (ASCII or binary) or .sre")->required();
     cmd->add_flag("--json", opts->json,
                   "Print one JSON object (input, healing, mesh, timing, warnings) on stdout");
