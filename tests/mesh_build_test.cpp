@@ -298,6 +298,19 @@ TEST(MeshBuild, AMeshThatPassesThroughItselfIsFound) {
     TriangleSoup shuffled = test::to_bucket(pushed);
     test::permute_facets(shuffled, 7);
     EXPECT_EQ(build_ok(shuffled).heal.self_intersections, h.self_intersections);
+    // Missing a facet away from the pushed vertex: checked once, on the mesh its filled hole
+    // closes, the same pairs.
+    test::Indexed holed = pushed;
+    for (std::size_t k = 0; k < holed.triangles.size(); ++k) {
+        const test::Tri& tri = holed.triangles[k];
+        if (tri[0] != far && tri[1] != far && tri[2] != far && holed.points[tri[0]].x > 5) {
+            holed.triangles.erase(holed.triangles.begin() + static_cast<std::ptrdiff_t>(k));
+            break;
+        }
+    }
+    const BuildResult filled = build_ok(test::to_bucket(holed));
+    EXPECT_EQ(filled.heal.holes_filled, 1u);
+    EXPECT_EQ(filled.heal.self_intersections, h.self_intersections);
 
     // A cube's corner pushed straight through the diagonal of the opposite wall: the edges that
     // cross pass through the border between the wall's two facets (told by the wedge those

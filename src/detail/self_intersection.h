@@ -5,9 +5,7 @@
 // them and mends none.
 #pragma once
 
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -41,9 +39,7 @@ struct SelfIntersections {
     /// False when the work bound (kSelfIntersectionWork) stopped the check: then no pair is
     /// counted.
     bool complete = true;
-    /// The crossing pair (first < second) of least indices, kNoFacet for none, and a point where
-    /// they meet.
-    std::uint32_t first = kNoFacet, second = kNoFacet;
+    /// Where the crossing pair of least indices meets.
     Vec3 at{};
 };
 
@@ -130,9 +126,11 @@ bool facets_cross(const Triangle& u, const std::array<std::uint32_t, 3>& iu, std
             ++shared;
         }
     }
-    // Edge k of a triangle runs from corner k to corner k + 1.
-    const auto through = [&](const Triangle& a, std::size_t k, const Triangle& b) {
-        const bool from_u = &a == &u;
+    // Whether edge k of u (from_u) or of t, from corner k to corner k + 1, passes through the
+    // other.
+    const auto through = [&](bool from_u, std::size_t k) {
+        const Triangle& a = from_u ? u : t;
+        const Triangle& b = from_u ? t : u;
         const Vec3 p = a[k], q = a[(k + 1) % 3];
         const Pierce how = pierces(p, q, b, tol);
         if (how == Pierce::kBorder)
@@ -145,7 +143,7 @@ bool facets_cross(const Triangle& u, const std::array<std::uint32_t, 3>& iu, std
         // Most pairs the tree hands out: one wholly on one side of the other's plane.
         if (apart(u, t, tol) || apart(t, u, tol)) return false;
         for (std::size_t k = 0; k < 3; ++k)
-            if (through(u, k, t) || through(t, k, u)) return true;
+            if (through(true, k) || through(false, k)) return true;
         return false;
     }
     if (shared == 1) {
@@ -155,7 +153,7 @@ bool facets_cross(const Triangle& u, const std::array<std::uint32_t, 3>& iu, std
                 if (!s[k] && !s[(k + 1) % 3]) return k;
             return std::size_t{0};
         };
-        return through(u, opposite(u_shared), t) || through(t, opposite(t_shared), u);
+        return through(true, opposite(u_shared)) || through(false, opposite(t_shared));
     }
     if (shared == 2) {
         std::size_t ku = 0, kt = 0;  // the unshared corners
@@ -198,18 +196,6 @@ SelfIntersections self_intersections(std::span<const std::uint32_t> component, d
     }
     tol = std::max(tol, kTouchShare * all.diagonal());
     const TriangleTree tree(std::move(tris));
-    // The facets' components and vertex ids in the tree's order, where the pairs come from:
-    // read one after another rather than all over the mesh.
-    std::vector<std::uint32_t> comp_at(nf);
-    std::vector<std::array<std::uint32_t, 3>> ids_at(nf);
-    tbb::parallel_for(
-        tbb::blocked_range<std::uint32_t>(0, static_cast<std::uint32_t>(nf), 1u << 14),
-        [&](const auto& r) {
-            for (std::uint32_t pos = r.begin(); pos != r.end(); ++pos) {
-                comp_at[pos] = component[tree.index(pos)];
-                ids_at[pos] = ids(tree.index(pos));
-            }
-        });
     // Per thread: pairs handed out (told the others every kWorkFlush and at the end), pairs
     // that cross, and the least of those.
     struct Tally {
@@ -227,13 +213,13 @@ SelfIntersections self_intersections(std::span<const std::uint32_t> component, d
             mine.work = 0;
         }
         if (stopped) return false;
-        if (comp_at[a] != comp_at[b]) return true;
         // Always the lower index first: the same answer whichever way the tree pairs them.
         if (tree.index(b) < tree.index(a)) std::swap(a, b);
         const std::uint32_t f = tree.index(a), g = tree.index(b);
+        if (component[f] != component[g]) return true;
         Vec3 at;
-        if (!facets_cross(tree.triangle(a), ids_at[a], f, tree.triangle(b), ids_at[b], g, across,
-                          tol, at))
+        if (!facets_cross(tree.triangle(a), ids(f), f, tree.triangle(b), ids(g), g, across, tol,
+                          at))
             return true;
         ++mine.found;
         if (mine.first == kNoFacet || f < mine.first || (f == mine.first && g < mine.second)) {
@@ -243,20 +229,17 @@ SelfIntersections self_intersections(std::span<const std::uint32_t> component, d
         }
         return true;
     });
-    std::uint64_t pairs = 0;
+    Tally least;  // the crossing pair of least indices, of all threads'
     for (const Tally& t : tallies) {
         if (work.fetch_add(t.work) + t.work > kSelfIntersectionWork) stopped = true;
-        pairs += t.found;
-        if (t.first == kNoFacet) continue;
-        if (out.first == kNoFacet || t.first < out.first ||
-            (t.first == out.first && t.second < out.second)) {
-            out.first = t.first;
-            out.second = t.second;
-            out.at = t.at;
+        out.pairs += t.found;
+        if (t.first != kNoFacet && (least.first == kNoFacet || t.first < least.first ||
+                                    (t.first == least.first && t.second < least.second))) {
+            least = t;
         }
     }
-    if (stopped) return SelfIntersections{0, false, kNoFacet, kNoFacet, {}};
-    out.pairs = pairs;
+    if (stopped) return SelfIntersections{0, false, {}};
+    out.at = least.at;
     return out;
 }
 

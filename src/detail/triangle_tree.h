@@ -150,9 +150,8 @@ class TriangleTree {
         }
     }
 
-    /// The triangles in the tree's order (near ones together): how many, the one at position
-    /// `pos`, and its index in the vector the tree was made from.
-    std::size_t size() const { return tris_.size(); }
+    /// The triangle at position `pos` of the tree's order (near ones together), and its index in
+    /// the vector the tree was made from.
     const Triangle& triangle(std::uint32_t pos) const { return tris_[pos]; }
     std::uint32_t index(std::uint32_t pos) const { return order_[pos]; }
     /// Calls fn(a, b) once for every two triangles whose boxes, one grown by `grow`, meet (a, b

@@ -744,38 +744,6 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     } else {
         std::fill(flip.begin(), flip.end(), 0);
     }
-    // Facets of one component that cross each other: reported, not mended. Each facet as the
-    // orientation turns it (flip: v0 v1 v2 -> v0 v2 v1, its edge in slot i to slot 2 - i), so
-    // that facets across an edge agree on their sides (crossings through a border are told by
-    // the wedge the two make; none where nothing was oriented).
-    {
-        const auto ids = [&](std::uint32_t f) {
-            const std::size_t h = 3 * std::size_t{f};
-            return flip[f] ? std::array<std::uint32_t, 3>{corner[h], corner[h + 2], corner[h + 1]}
-                           : std::array<std::uint32_t, 3>{corner[h], corner[h + 1], corner[h + 2]};
-        };
-        const auto corners = [&](std::uint32_t f) {
-            const std::array<std::uint32_t, 3> v = ids(f);
-            return std::array<Vec3, 3>{vpos[v[0]], vpos[v[1]], vpos[v[2]]};
-        };
-        const auto across = [&](std::uint32_t f, int k, std::uint32_t& g,
-                                std::array<Vec3, 3>& other, std::array<std::uint32_t, 3>& vids) {
-            if (!options.orient) return false;
-            const std::uint32_t slot =
-                flip[f] ? 2 - static_cast<std::uint32_t>(k) : static_cast<std::uint32_t>(k);
-            const std::uint32_t m = mate[3 * std::size_t{f} + slot];
-            if (m == kNone) return false;
-            g = m / 3;
-            other = corners(g);
-            vids = ids(g);
-            return true;
-        };
-        const detail::SelfIntersections crossed =
-            detail::self_intersections(comp, tol, corners, ids, across);
-        rep.self_intersections = crossed.pairs;
-        rep.self_intersection_at = crossed.at;
-        rep.self_intersection_unchecked = !crossed.complete;
-    }
     comp = {};
     report_progress("orient", 1.0);
 
@@ -1090,9 +1058,6 @@ Result<BuildResult> MeshBuilder::rebuild(
     heal.nesting_unchecked = second.nesting_unchecked;
     heal.crossing_components = second.crossing_components;
     heal.crossing_unchecked = second.crossing_unchecked;
-    heal.self_intersections = second.self_intersections;
-    heal.self_intersection_at = second.self_intersection_at;
-    heal.self_intersection_unchecked = second.self_intersection_unchecked;
     rebuilt->heal = std::move(heal);
     return rebuilt;
 }
@@ -1201,19 +1166,66 @@ Result<BuildResult> MeshBuilder::fill_holes(BuildResult built, const HealOptions
     return built;
 }
 
+namespace {
+
+/// Healing's last step, on the mesh as built (holes filled, once): the facet pairs of one
+/// component that cross each other, reported, not mended. Its facets are turned as the
+/// orientation made them, so that two across an edge agree on their sides (a crossing through
+/// the border between them is told by the wedge they make); where nothing was oriented, no
+/// border crossing is told.
+void report_self_intersections(BuildResult& built, const HealOptions& options,
+                               const ProgressFn& progress) {
+    if (progress) progress("self-intersections", 0.0);
+    const Mesh& m = built.mesh;
+    const auto ids = [&](std::uint32_t f) {
+        return std::array<std::uint32_t, 3>{m.vertex(FaceId(f), 0).idx(),
+                                            m.vertex(FaceId(f), 1).idx(),
+                                            m.vertex(FaceId(f), 2).idx()};
+    };
+    const auto corners = [&](std::uint32_t f) {
+        return std::array<Vec3, 3>{m.position(m.vertex(FaceId(f), 0)),
+                                   m.position(m.vertex(FaceId(f), 1)),
+                                   m.position(m.vertex(FaceId(f), 2))};
+    };
+    const auto across = [&](std::uint32_t f, int k, std::uint32_t& g, std::array<Vec3, 3>& other,
+                            std::array<std::uint32_t, 3>& vids) {
+        const HalfedgeId h = Mesh::halfedge(FaceId(f), k);
+        if (!options.orient || m.is_boundary(h)) return false;
+        g = Mesh::face(m.twin(h)).idx();
+        other = corners(g);
+        vids = ids(g);
+        return true;
+    };
+    const detail::SelfIntersections crossed = detail::self_intersections(
+        face_components(m).of_face, built.heal.tolerance, corners, ids, across);
+    built.heal.self_intersections = crossed.pairs;
+    built.heal.self_intersection_at = crossed.at;
+    built.heal.self_intersection_unchecked = !crossed.complete;
+    if (progress) progress("self-intersections", 1.0);
+}
+
+Result<BuildResult> heal_rest(Result<BuildResult> built, const HealOptions& options,
+                              const ProgressFn& progress) {
+    if (!built.ok()) return built;
+    if (options.fill_holes) {
+        built = MeshBuilder::fill_holes(std::move(built).value(), options, progress);
+        if (!built.ok()) return built;
+    }
+    report_self_intersections(*built, options, progress);
+    return built;
+}
+
+}  // namespace
+
 Result<BuildResult> build_mesh(const TriangleSoup& soup, const HealOptions& options,
                                const ProgressFn& progress) {
-    Result<BuildResult> built = MeshBuilder::build(soup, nullptr, options, progress);
-    if (!built.ok() || !options.fill_holes) return built;
-    return MeshBuilder::fill_holes(std::move(built).value(), options, progress);
+    return heal_rest(MeshBuilder::build(soup, nullptr, options, progress), options, progress);
 }
 
 Result<BuildResult> build_mesh(TriangleSoup&& soup, const HealOptions& options,
                                const ProgressFn& progress) {
     TriangleSoup owned = std::move(soup);
-    Result<BuildResult> built = MeshBuilder::build(owned, &owned, options, progress);
-    if (!built.ok() || !options.fill_holes) return built;
-    return MeshBuilder::fill_holes(std::move(built).value(), options, progress);
+    return heal_rest(MeshBuilder::build(owned, &owned, options, progress), options, progress);
 }
 
 }  // namespace ncrev
