@@ -5,7 +5,9 @@
 // them and mends none.
 #pragma once
 
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -15,13 +17,14 @@
 #include <span>
 #include <vector>
 
+#include "detail/box_pairs.h"
 #include "detail/nesting.h"
 #include "detail/triangle_tree.h"
 #include "ncrev/common.h"
 
 namespace ncrev::detail {
 
-/// Facet pairs whose boxes meet, as the tree's search hands them out, at most, before the check
+/// Facet pairs whose boxes meet, as the search hands them out, at most, before the check
 /// gives up: a bound of some ten seconds. A mesh of a machined part has about a dozen per facet
 /// (a facet's box meets those of its fans and a few more): 24M on a ball of 2M facets, 1.1 s
 /// (docs/benchmarks.md). A pile of facets over one another in one place would otherwise cost
@@ -179,23 +182,29 @@ bool facets_cross(const Triangle& u, const std::array<std::uint32_t, 3>& iu, std
 /// each once: `corners(f)` facet f's three points, `ids(f)` their vertex ids (both in the
 /// order the mesh's orientation gives), `across` as crosses_border() asks it, `tol` the distance
 /// within which points touch (at least kTouchShare of the mesh's size). Facets of different
-/// components are not compared: closed ones that cross are crossing_components()'s. A tree of
-/// all facets hands each facet those whose boxes may meet its own; past kSelfIntersectionWork
-/// of them the check stops, incomplete. Deterministic on any thread count.
+/// components are not compared: closed ones that cross are crossing_components()'s. The facets
+/// whose boxes, grown by `tol`, meet are found by BoxPairs; past kSelfIntersectionWork of them
+/// the check stops, incomplete. Deterministic on any thread count.
 template <class Corners, class Ids, class Across>
 SelfIntersections self_intersections(std::span<const std::uint32_t> component, double tol,
                                      const Corners& corners, const Ids& ids, const Across& across) {
     SelfIntersections out;
-    const std::size_t nf = component.size();
+    const auto nf = static_cast<std::uint32_t>(component.size());
     if (nf < 2) return out;
-    std::vector<Triangle> tris(nf);
-    Box3 all;
-    for (std::size_t f = 0; f < nf; ++f) {
-        tris[f] = corners(static_cast<std::uint32_t>(f));
-        for (const Vec3& p : tris[f]) all.add(p);
-    }
+    const auto box = [&](std::uint32_t f) { return box_of(corners(f)); };
+    const Box3 all = tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(0, nf, kTreeGrain), Box3{},
+        [&](const auto& r, Box3 acc) {
+            for (std::uint32_t f = r.begin(); f != r.end(); ++f) acc.add(box(f));
+            return acc;
+        },
+        [](Box3 a, const Box3& b) {
+            a.add(b);
+            return a;
+        });
     tol = std::max(tol, kTouchShare * all.diagonal());
-    const TriangleTree tree(std::move(tris));
+    // Each box grown by half the distance: two meet when one grown by all of it meets the other.
+    const BoxPairs pairs(nf, box, 0.5 * tol);
     // Per thread: pairs handed out (told the others every kWorkFlush and at the end), pairs
     // that cross, and the least of those.
     struct Tally {
@@ -206,29 +215,32 @@ SelfIntersections self_intersections(std::span<const std::uint32_t> component, d
     tbb::enumerable_thread_specific<Tally> tallies;
     std::atomic<std::uint64_t> work{0};
     std::atomic<bool> stopped{false};
-    tree.for_each_pair(tol, [&](std::uint32_t a, std::uint32_t b) {
-        Tally& mine = tallies.local();
-        if (++mine.work >= kWorkFlush) {
-            if (work.fetch_add(mine.work) + mine.work > kSelfIntersectionWork) stopped = true;
-            mine.work = 0;
-        }
-        if (stopped) return false;
-        // Always the lower index first: the same answer whichever way the tree pairs them.
-        if (tree.index(b) < tree.index(a)) std::swap(a, b);
-        const std::uint32_t f = tree.index(a), g = tree.index(b);
-        if (component[f] != component[g]) return true;
-        Vec3 at;
-        if (!facets_cross(tree.triangle(a), ids(f), f, tree.triangle(b), ids(g), g, across, tol,
-                          at))
-            return true;
-        ++mine.found;
-        if (mine.first == kNoFacet || f < mine.first || (f == mine.first && g < mine.second)) {
-            mine.first = f;
-            mine.second = g;
-            mine.at = at;
-        }
-        return true;
-    });
+    pairs.for_each_pair(
+        [&](std::span<const BoxPairs::Pair> batch) {
+            Tally& mine = tallies.local();
+            mine.work += batch.size();
+            if (mine.work >= kWorkFlush) {
+                if (work.fetch_add(mine.work) + mine.work > kSelfIntersectionWork) stopped = true;
+                mine.work = 0;
+            }
+            if (stopped) return;
+            for (auto [f, g] : batch) {
+                if (component[f] != component[g]) continue;
+                // Always the lower index first: the same answer whichever way they are paired.
+                if (g < f) std::swap(f, g);
+                Vec3 at;
+                if (!facets_cross(corners(f), ids(f), f, corners(g), ids(g), g, across, tol, at))
+                    continue;
+                ++mine.found;
+                if (mine.first == kNoFacet || f < mine.first ||
+                    (f == mine.first && g < mine.second)) {
+                    mine.first = f;
+                    mine.second = g;
+                    mine.at = at;
+                }
+            }
+        },
+        stopped);
     Tally least;  // the crossing pair of least indices, of all threads'
     for (const Tally& t : tallies) {
         if (work.fetch_add(t.work) + t.work > kSelfIntersectionWork) stopped = true;

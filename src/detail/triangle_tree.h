@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -150,23 +149,6 @@ class TriangleTree {
         }
     }
 
-    /// The triangle at position `pos` of the tree's order (near ones together), and its index in
-    /// the vector the tree was made from.
-    const Triangle& triangle(std::uint32_t pos) const { return tris_[pos]; }
-    std::uint32_t index(std::uint32_t pos) const { return order_[pos]; }
-    /// Calls fn(a, b) once for every two triangles whose boxes, one grown by `grow`, meet (a, b
-    /// their positions in the tree's order: triangle(), index()): the pairs of a leaf, and of
-    /// two leaves whose boxes meet, found by descending both sides of every two nodes whose
-    /// boxes meet (no query from the root per triangle). The large branches on all cores: fn
-    /// is called concurrently, in no set order. Once fn returns false, no more calls are begun
-    /// and the search ends.
-    template <class Fn>
-    void for_each_pair(double grow, Fn&& fn) const {
-        if (tris_.size() < 2) return;
-        std::atomic<bool> stop{false};
-        Pairs<Fn> p{fn, grow, stop};
-        pairs_within(0, p, 0);
-    }
     /// Distance from p to the nearest triangle.
     double distance(Vec3 p) const {
         if (tris_.empty()) return 0;
@@ -327,74 +309,6 @@ class TriangleTree {
         nodes_[slot].box = box;
     }
 
-    // Branches this many levels from the root or fewer are searched on all cores.
-    static constexpr int kParallelPairDepth = 10;
-    template <class Fn>
-    struct Pairs {
-        Fn& fn;
-        double grow;
-        std::atomic<bool>& stop;
-    };
-    template <class P>
-    void leaf_pairs(const Node& a, const Node& b, P& p) const {
-        for (std::uint32_t i = a.first; i < a.first + a.count; ++i) {
-            const Box3 bi = grown(box_of(tris_[i]), p.grow);
-            // Within one leaf, each pair once.
-            for (std::uint32_t j = &a == &b ? i + 1 : b.first; j < b.first + b.count; ++j) {
-                if (!boxes_meet(bi, box_of(tris_[j]))) continue;
-                if (!p.fn(i, j)) {
-                    p.stop = true;
-                    return;
-                }
-            }
-        }
-    }
-    template <class P>
-    void pairs_within(std::uint32_t node, P& p, int depth) const {
-        if (p.stop) return;
-        const Node& n = nodes_[node];
-        if (n.count > 0) {
-            leaf_pairs(n, n, p);
-            return;
-        }
-        const std::uint32_t a = n.first, b = n.first + 1;
-        if (depth < kParallelPairDepth) {
-            tbb::parallel_invoke([&] { pairs_within(a, p, depth + 1); },
-                                 [&] { pairs_within(b, p, depth + 1); },
-                                 [&] { pairs_across(a, b, p, depth + 1); });
-            return;
-        }
-        pairs_within(a, p, depth + 1);
-        pairs_within(b, p, depth + 1);
-        pairs_across(a, b, p, depth + 1);
-    }
-    template <class P>
-    void pairs_across(std::uint32_t x, std::uint32_t y, P& p, int depth) const {
-        if (p.stop) return;
-        const Node& a = nodes_[x];
-        const Node& b = nodes_[y];
-        if (!boxes_meet(grown(a.box, p.grow), b.box)) return;
-        if (a.count > 0 && b.count > 0) {
-            leaf_pairs(a, b, p);
-            return;
-        }
-        // The inner node's children (the larger box's, when both are inner) against the other.
-        const bool split_a = b.count > 0 || (a.count == 0 && a.box.diagonal() >= b.box.diagonal());
-        const std::uint32_t keep = split_a ? y : x, c = split_a ? a.first : b.first;
-        const auto across = [&](std::uint32_t child) {
-            if (split_a) {
-                pairs_across(child, keep, p, depth + 1);
-            } else {
-                pairs_across(keep, child, p, depth + 1);
-            }
-        };
-        if (depth < kParallelPairDepth) {
-            tbb::parallel_invoke([&] { across(c); }, [&] { across(c + 1); });
-            return;
-        }
-        across(c);
-        across(c + 1);
-    }
     std::vector<Triangle> tris_;
     std::vector<std::uint32_t> order_;
     std::vector<Node> nodes_;
