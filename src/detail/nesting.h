@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "detail/box_pairs.h"
 #include "detail/triangle_tree.h"
 #include "ncrev/common.h"
 
@@ -39,9 +40,12 @@ inline constexpr std::uint32_t kNotNested = 0xffffffffu;
 /// edges meet the others' borders (each asking which side its ends are on), reach it after 3.9 s
 /// and are left unchecked (8.3 s to check them all).
 inline constexpr std::uint64_t kCrossingWork = 30'000'000;
-/// Facet pairs a tree hands out per facet, about, when both sides are large: a facet's box
+/// Facet pairs a search hands out per facet, about, when both sides are large: a facet's box
 /// meets those of a few facets of the other side, where the two lie close.
 inline constexpr std::uint64_t kCandidatesPerFacet = 8;
+/// Facet pairs of two parts' near sides compared one by one, without a search, at most: a few
+/// microseconds of box tests, less than setting up the search (its sort and passes).
+inline constexpr std::uint64_t kEveryPair = 4096;
 
 /// Points nearer each other than this share of the closed components' size count as touching
 /// when no tolerance larger is given: about eight float32 rounding steps at the model's size, as
@@ -118,8 +122,8 @@ struct Nesting {
 /// from outside the other component to inside it (each end off its surface by more than `tol`;
 /// inside by the parity of rays, as nesting tests). Parts that only touch (a face on a face, an
 /// edge along a face or across an edge) do not cross. `pairs`: the pairs whose boxes meet; of
-/// each, only the facets within both boxes are compared (one side's through a tree of the
-/// other's), stopping at the first crossing. `facets[c]`: component c's facets (for every c of
+/// each, only the facets within both boxes are compared (those whose boxes meet, found by
+/// BoxPairs), stopping at the first crossing. `facets[c]`: component c's facets (for every c of
 /// a pair). The work is counted before each pair is compared (kCrossingWork): past it,
 /// `complete` is false and no pair is listed.
 template <class Corners>
@@ -171,14 +175,13 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
             both.max[k] = std::min(box[a].max[k], box[b].max[k]);
         }
         both = grown(both, tol);
-        // The facets of each side within both boxes; the tree over the smaller side (copies of
-        // its triangles), the other side's facets ask it.
+        // The facets of each side within both boxes.
         std::array<std::vector<std::uint32_t>, 2> near;
         for (std::size_t side = 0; side < 2; ++side) {
             for (const std::uint32_t f : facets[side == 0 ? a : b])
                 if (boxes_meet(box_of(corners(f)), both)) near[side].push_back(f);
         }
-        // The scan, and the facet pairs the tree may hand out: every pair when the sides are
+        // The scan, and the facet pairs the search may hand out: every pair when the sides are
         // small (two cubes over each other), a few per facet when they are large.
         const std::uint64_t na = near[0].size(), nb = near[1].size();
         work += facets[a].size() + facets[b].size() +
@@ -188,32 +191,63 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_components(
             return {};
         }
         if (near[0].empty() || near[1].empty()) continue;
-        const bool tree_a = near[0].size() < near[1].size();
-        const std::uint32_t tc = tree_a ? a : b, qc = tree_a ? b : a;
-        const std::vector<std::uint32_t>& asking = near[tree_a ? 1 : 0];
-        const TriangleTree tree = [&] {
-            std::vector<std::uint32_t>& mine = near[tree_a ? 0 : 1];
-            std::vector<Triangle> tris(mine.size());
-            for (std::size_t i = 0; i < mine.size(); ++i) tris[i] = corners(mine[i]);
-            mine = {};
-            return TriangleTree(std::move(tris));
-        }();
+        // Whether facet f of side a and facet g of side b cross; with `through_only`, only
+        // through a facet's inside (a pierce through a border asks which side of a whole
+        // component each end lies, through a tree of it: noted in `border`, left to a second
+        // pass, which two parts crossing through each other's insides never need).
+        const std::uint32_t ca = a, cb = b;
+        std::atomic<bool> border{false};
+        const auto cross = [&](std::uint32_t f, std::uint32_t g, bool through_only) {
+            const Triangle u = corners(f), t = corners(g);
+            if (apart(u, t, tol) || apart(t, u, tol)) return false;
+            for (std::size_t k = 0; k < 3; ++k) {
+                if (through_only) {
+                    const Pierce x = pierces(u[k], u[(k + 1) % 3], t, tol);
+                    const Pierce y = pierces(t[k], t[(k + 1) % 3], u, tol);
+                    if (x == Pierce::kThrough || y == Pierce::kThrough) return true;
+                    if (x == Pierce::kBorder || y == Pierce::kBorder) border = true;
+                } else if (passes(u[k], u[(k + 1) % 3], t, cb) ||
+                           passes(t[k], t[(k + 1) % 3], u, ca)) {
+                    return true;
+                }
+            }
+            return false;
+        };
         std::atomic<bool> found{false};
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, asking.size(), 1024),
-                          [&](const auto& r) {
-                              for (std::size_t i = r.begin(); i != r.end() && !found; ++i) {
-                                  const Triangle u = corners(asking[i]);
-                                  bool hit = false;
-                                  tree.for_each_near(grown(box_of(u), tol), [&](const Triangle& t) {
-                                      if (hit || apart(u, t, tol) || apart(t, u, tol)) return;
-                                      for (std::size_t k = 0; k < 3 && !hit; ++k) {
-                                          hit = passes(u[k], u[(k + 1) % 3], t, tc) ||
-                                                passes(t[k], t[(k + 1) % 3], u, qc);
-                                      }
-                                  });
-                                  if (hit) found = true;
-                              }
-                          });
+        if (na * nb <= kEveryPair) {
+            // Two small parts (cubes over each other): every pair, no search to set up.
+            for (std::size_t i = 0; i < na && !found; ++i) {
+                const Box3 bi = grown(box_of(corners(near[0][i])), tol);
+                for (std::size_t j = 0; j < nb && !found; ++j) {
+                    if (boxes_meet(bi, box_of(corners(near[1][j]))) &&
+                        cross(near[0][i], near[1][j], false))
+                        found = true;
+                }
+            }
+        } else {
+            // The facets of both sides in one search for boxes that meet (BoxPairs); of each
+            // pair found, those from both sides compared.
+            const auto n = static_cast<std::uint32_t>(na + nb);
+            const auto facet = [&](std::uint32_t i) {
+                return i < na ? near[0][i] : near[1][i - na];
+            };
+            const BoxPairs search(
+                n, [&](std::uint32_t i) { return box_of(corners(facet(i))); }, 0.5 * tol);
+            for (const bool through_only : {true, false}) {
+                if (!through_only && !border) break;
+                search.for_each_pair(
+                    [&](std::span<const BoxPairs::Pair> batch) {
+                        for (auto [i, j] : batch) {
+                            if ((i < na) == (j < na)) continue;
+                            if (j < na) std::swap(i, j);
+                            if (found) return;
+                            if (cross(facet(i), facet(j), through_only)) found = true;
+                        }
+                    },
+                    found);
+                if (found) break;
+            }
+        }
         if (found) out.emplace_back(a, b);
     }
     return out;
