@@ -238,6 +238,8 @@ TEST(MeshBuild, PartsThatCrossAreFoundAndNeverNested) {
         test::merge(box({0, 10, 0}, {30, 20, 10}), box({10, 0, 2}, {20, 30, 8}));
     const test::Indexed resting =
         test::merge(test::cube({0, 0, 0}, 10), test::cube({3, 3, 10}, 10));
+    const test::Indexed fine_resting =
+        test::merge(finer(test::cube({0, 0, 0}, 10), 5), test::cube({3, 3, 10}, 10));
     const test::Indexed cavity = test::merge(test::cube({0, 0, 0}, 10), test::cube({2, 2, 2}, 6));
     for (const bool turn : {false, true}) {
         for (const test::Indexed* m : {&cubes, &plus, &fine_cubes}) {
@@ -250,9 +252,14 @@ TEST(MeshBuild, PartsThatCrossAreFoundAndNeverNested) {
             EXPECT_EQ(n.crossing, (std::vector<std::pair<std::uint32_t, std::uint32_t>>{{0, 1}}));
             EXPECT_EQ(n.depth, (std::vector<std::uint32_t>{0, 0}));
         }
-        const BuildResult r = crossing(resting, turn);
-        EXPECT_EQ(r.heal.crossing_components, 0u) << turn;
-        EXPECT_TRUE(component_nesting(r.mesh).crossing.empty());
+        // Also with the lower cube in 12288 facets: more facet pairs near the contact than are
+        // compared one by one (kEveryPair), so they come from a search.
+        for (const test::Indexed* m : {&resting, &fine_resting}) {
+            const BuildResult r = crossing(*m, turn);
+            EXPECT_EQ(r.heal.crossing_components, 0u) << turn;
+            EXPECT_FALSE(r.heal.crossing_unchecked);
+            EXPECT_TRUE(component_nesting(r.mesh).crossing.empty());
+        }
         const BuildResult c = crossing(cavity, turn);
         EXPECT_EQ(c.heal.crossing_components, 0u) << turn;
         EXPECT_EQ(c.heal.cavities, 1u);
