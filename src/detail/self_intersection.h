@@ -25,10 +25,10 @@
 namespace ncrev::detail {
 
 /// Facet pairs whose boxes meet, as the search hands them out, at most, before the check
-/// gives up: a bound of some ten seconds. A mesh of a machined part has about a dozen per facet
-/// (a facet's box meets those of its fans and a few more): 24M on a ball of 2M facets, 1.1 s
-/// (docs/benchmarks.md). A pile of facets over one another in one place would otherwise cost
-/// facets squared.
+/// gives up: a bound of some fifteen seconds. A mesh of a machined part has about a dozen per
+/// facet (a facet's box meets those of its fans and a few more): 24M on a ball of 2M facets,
+/// searched and compared in about 1 s (docs/benchmarks.md). A pile of facets over one another
+/// in one place would otherwise cost facets squared.
 inline constexpr std::uint64_t kSelfIntersectionWork = 400'000'000;
 
 /// Pairs a task counts before it adds them to the shared count (and learns whether to stop).
