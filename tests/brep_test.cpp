@@ -171,6 +171,47 @@ TEST(Reverse, OpenMeshGivesAShellAndAWarning) {
     EXPECT_GT(back.faces, 0u);
 }
 
+// A mesh through itself (a ball's vertex pushed out through the far wall): reverse_to_step()
+// builds it, but with require_solid writes nothing, whether it searches the mesh itself or
+// takes the count from the healing report it is given; a mesh without a crossing is written.
+TEST(Reverse, RequireSolidRefusesAMeshThroughItself) {
+    test::Indexed pushed = test::icosphere(10.0, 2);
+    std::size_t far = 0;
+    for (std::size_t i = 0; i < pushed.points.size(); ++i)
+        if (pushed.points[i].x > pushed.points[far].x) far = i;
+    pushed.points[far] = Vec3{-12, 0.1, 0.2};
+    Result<BuildResult> built = build_mesh(test::to_bucket(pushed));
+    ASSERT_TRUE(built.ok());
+    ASSERT_GT(built->heal.self_intersections, 0u);
+    const SelfIntersectionReport found =
+        find_self_intersections(built->mesh, built->heal.tolerance);
+    EXPECT_EQ(found.pairs, built->heal.self_intersections);
+    EXPECT_EQ(found.at, built->heal.self_intersection_at);
+    const auto path = out_dir() / "through_itself.step";
+    ReverseOptions o;
+    o.method = ReverseMethod::kPlanar;
+    auto rev = reverse_to_step(built->mesh, path, o);
+    ASSERT_TRUE(rev.ok());
+    EXPECT_TRUE(rev->written);  // built all the same, unless required
+    std::filesystem::remove(path);
+    o.require_solid = true;
+    const HealReport* known = &built->heal;
+    for (const HealReport* given : {static_cast<const HealReport*>(nullptr), known}) {
+        o.heal = given;
+        rev = reverse_to_step(built->mesh, path, o);
+        ASSERT_TRUE(rev.ok());
+        EXPECT_FALSE(rev->written);
+        EXPECT_FALSE(std::filesystem::exists(path));
+        ASSERT_FALSE(rev->warnings.empty());
+        EXPECT_NE(rev->warnings.back().find("passes through itself"), std::string::npos);
+    }
+    o.heal = nullptr;
+    rev = reverse_to_step(heal(test::to_bucket(test::icosphere(10.0, 2))), path, o);
+    ASSERT_TRUE(rev.ok());
+    EXPECT_TRUE(rev->written);
+    std::filesystem::remove(path);
+}
+
 TEST(Reverse, SameMeshGivesByteIdenticalStep) {
     const Mesh mesh = heal(tessellate(planar_parts()[0].shape, 0.1));
     const auto a = out_dir() / "det_a.step", b = out_dir() / "det_b.step";

@@ -116,17 +116,6 @@ void add_reverse(CLI::App& app, Context& ctx) {
                               ".step or .stp");
             }
         }
-        // Whatever is built from a mesh through itself passes through itself too: no solid a CAD
-        // system takes, which --require-solid asks for.
-        if (o->require_solid && healed->report.heal.self_intersections > 0) {
-            if (!o->quiet)
-                for (const std::string& w : healed->report.warnings) print_warning(w);
-            print_error(o->input +
-                        ": the mesh passes through itself: no valid solid, nothing written "
-                        "(--require-solid)");
-            ctx.exit_code = kExitNoResult;
-            return;
-        }
         const auto progress = terminal_progress(ctx, o->quiet);
         ReverseOptions ro;
         ro.method = o->method;
@@ -136,6 +125,7 @@ void add_reverse(CLI::App& app, Context& ctx) {
         ro.progress = progress;
         ro.colors = !o->no_colors;
         ro.require_solid = o->require_solid;
+        ro.heal = &healed->report.heal;
         ro.segment.tolerance = o->tolerance;
         ro.segment.surfaces = healed->surfaces;
         ro.segment.tools = healed->tools;

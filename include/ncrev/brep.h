@@ -59,8 +59,13 @@ struct ReverseOptions {
     /// Measure the deviation between the solid and the mesh (ReverseReport::deviation).
     bool measure_deviation = true;
     /// Write nothing (a warning says why) unless the result is solids: an open mesh with the
-    /// planar methods, or with auto / surfaces when its closed components are not most of it.
+    /// planar methods, or with auto / surfaces when its closed components are not most of it,
+    /// and a mesh that passes through itself (its solid would too; find_self_intersections()).
     bool require_solid = false;
+    /// The healing report of `mesh` (build_mesh()), when the caller has it: require_solid then
+    /// takes its self_intersections instead of searching the mesh again. Not owned; null: the
+    /// mesh is searched (find_self_intersections(), at the default weld tolerance).
+    const HealReport* heal = nullptr;
     ProgressFn progress;  ///< one call at the start and end of each stage
 };
 

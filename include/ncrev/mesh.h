@@ -322,4 +322,21 @@ double coordinate_rounding(const Mesh& mesh);
 /// The default weld tolerance for points whose bounding box is `box`, and its rule in words.
 double default_weld_tolerance(const Box3& box, std::string* rule = nullptr);
 
+/// Facet pairs of one component of a mesh that cross each other (find_self_intersections()).
+struct SelfIntersectionReport {
+    std::uint64_t pairs = 0;
+    Vec3 at{};             ///< where the pair of least facet indices crosses (pairs > 0)
+    bool complete = true;  ///< false past the work bound: then no pair is counted
+};
+
+/// Where `mesh` passes through itself: the facet pairs of one component that cross (a vertex
+/// pushed through a wall, a surface folded over its neighbour; docs/healing.md step 9), which
+/// any solid built from it crosses too. What build_mesh() reports as
+/// HealReport::self_intersections, with `tolerance` the distance within which points touch
+/// (HealReport::tolerance; at least 1e-6 of the mesh's size whatever is given). `oriented`: the
+/// facets across each edge are turned alike (build_mesh() with HealOptions::orient, the
+/// default), so a pierce through the border between two facets can be told from a graze.
+SelfIntersectionReport find_self_intersections(const Mesh& mesh, double tolerance,
+                                               bool oriented = true);
+
 }  // namespace ncrev

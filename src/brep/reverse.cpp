@@ -749,6 +749,20 @@ Result<ReverseReport> reverse_to_step(const Mesh& mesh, const std::filesystem::p
     const MeshStats stats = compute_stats(mesh);
     rep.mesh_volume = stats.volume;
     rep.mesh_area = stats.area;
+    if (options.require_solid) {
+        // Whatever is built from a mesh through itself passes through itself too: no solid a
+        // CAD system takes (OpenCASCADE's check would pass it: docs/healing.md step 9).
+        const std::uint64_t crossing =
+            options.heal != nullptr
+                ? options.heal->self_intersections
+                : find_self_intersections(mesh, default_weld_tolerance(stats.bbox)).pairs;
+        if (crossing > 0) {
+            rep.warnings.push_back("the mesh passes through itself (" + std::to_string(crossing) +
+                                   " pairs of facets cross): no valid solid, nothing written "
+                                   "(required)");
+            return rep;
+        }
+    }
     const bool surfaces =
         options.method == ReverseMethod::kAuto || options.method == ReverseMethod::kSurfaces;
     if (surfaces && stats.closed) return reverse_surfaces(mesh, stats, output, options, rep);

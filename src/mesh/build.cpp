@@ -1176,28 +1176,8 @@ namespace {
 void report_self_intersections(BuildResult& built, const HealOptions& options,
                                const ProgressFn& progress) {
     if (progress) progress("self-intersections", 0.0);
-    const Mesh& m = built.mesh;
-    const auto ids = [&](std::uint32_t f) {
-        return std::array<std::uint32_t, 3>{m.vertex(FaceId(f), 0).idx(),
-                                            m.vertex(FaceId(f), 1).idx(),
-                                            m.vertex(FaceId(f), 2).idx()};
-    };
-    const auto corners = [&](std::uint32_t f) {
-        return std::array<Vec3, 3>{m.position(m.vertex(FaceId(f), 0)),
-                                   m.position(m.vertex(FaceId(f), 1)),
-                                   m.position(m.vertex(FaceId(f), 2))};
-    };
-    const auto across = [&](std::uint32_t f, int k, std::uint32_t& g, std::array<Vec3, 3>& other,
-                            std::array<std::uint32_t, 3>& vids) {
-        const HalfedgeId h = Mesh::halfedge(FaceId(f), k);
-        if (!options.orient || m.is_boundary(h)) return false;
-        g = Mesh::face(m.twin(h)).idx();
-        other = corners(g);
-        vids = ids(g);
-        return true;
-    };
-    const detail::SelfIntersections crossed = detail::self_intersections(
-        face_components(m).of_face, built.heal.tolerance, corners, ids, across);
+    const SelfIntersectionReport crossed =
+        find_self_intersections(built.mesh, built.heal.tolerance, options.orient);
     built.heal.self_intersections = crossed.pairs;
     built.heal.self_intersection_at = crossed.at;
     built.heal.self_intersection_unchecked = !crossed.complete;
@@ -1216,6 +1196,31 @@ Result<BuildResult> heal_rest(Result<BuildResult> built, const HealOptions& opti
 }
 
 }  // namespace
+
+SelfIntersectionReport find_self_intersections(const Mesh& m, double tolerance, bool oriented) {
+    const auto ids = [&](std::uint32_t f) {
+        return std::array<std::uint32_t, 3>{m.vertex(FaceId(f), 0).idx(),
+                                            m.vertex(FaceId(f), 1).idx(),
+                                            m.vertex(FaceId(f), 2).idx()};
+    };
+    const auto corners = [&](std::uint32_t f) {
+        return std::array<Vec3, 3>{m.position(m.vertex(FaceId(f), 0)),
+                                   m.position(m.vertex(FaceId(f), 1)),
+                                   m.position(m.vertex(FaceId(f), 2))};
+    };
+    const auto across = [&](std::uint32_t f, int k, std::uint32_t& g, std::array<Vec3, 3>& other,
+                            std::array<std::uint32_t, 3>& vids) {
+        const HalfedgeId h = Mesh::halfedge(FaceId(f), k);
+        if (!oriented || m.is_boundary(h)) return false;
+        g = Mesh::face(m.twin(h)).idx();
+        other = corners(g);
+        vids = ids(g);
+        return true;
+    };
+    const detail::SelfIntersections crossed =
+        detail::self_intersections(face_components(m).of_face, tolerance, corners, ids, across);
+    return SelfIntersectionReport{crossed.pairs, crossed.at, crossed.complete};
+}
 
 Result<BuildResult> build_mesh(const TriangleSoup& soup, const HealOptions& options,
                                const ProgressFn& progress) {
