@@ -69,8 +69,14 @@ enum class Pierce { kNo, kThrough, kBorder };
 /// plane) does not.
 inline Pierce pierces(Vec3 p, Vec3 q, const Triangle& t, double tol) {
     Vec3 n = cross(t[1] - t[0], t[2] - t[0]);
-    const double len = norm(n);
-    if (!(len > 0)) return Pierce::kNo;
+    // Most segments asked end on one side of the plane: told without a square root, the
+    // distances scaled by |n| (a distance d is more than tol off when d |n| is more than tol |n|).
+    const double len2 = dot(n, n);
+    if (!(len2 > 0)) return Pierce::kNo;
+    const double sp = dot(p - t[0], n), sq = dot(q - t[0], n), lim2 = tol * tol * len2;
+    const bool p_off = sp * sp > lim2, q_off = sq * sq > lim2;
+    if (!(p_off && q_off && (sp > 0) != (sq > 0))) return Pierce::kNo;
+    const double len = std::sqrt(len2);
     n = (1 / len) * n;
     const double dp = dot(p - t[0], n), dq = dot(q - t[0], n);
     if (!((dp > tol && dq < -tol) || (dp < -tol && dq > tol))) return Pierce::kNo;
@@ -91,13 +97,16 @@ inline Pierce pierces(Vec3 p, Vec3 q, const Triangle& t, double tol) {
 /// then no edge of either passes through the other (most pairs a tree hands out).
 inline bool apart(const Triangle& u, const Triangle& t, double tol) {
     const Vec3 n = cross(t[1] - t[0], t[2] - t[0]);
-    const double len = norm(n);
-    if (!(len > 0)) return true;
+    // Distances scaled by |n|, compared squared: no square root, no division.
+    const double len2 = dot(n, n);
+    if (!(len2 > 0)) return true;
+    const double lim2 = tol * tol * len2;
     int above = 0, below = 0;
     for (const Vec3& v : u) {
-        const double d = dot(v - t[0], n) / len;
-        above += d > tol;
-        below += d < -tol;
+        const double d = dot(v - t[0], n);
+        const bool off = d * d > lim2;
+        above += off && d > 0;
+        below += off && d < 0;
     }
     return above == 3 || below == 3;
 }
