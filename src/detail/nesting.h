@@ -6,6 +6,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -369,12 +370,25 @@ Nesting nest_components(std::span<const std::uint32_t> component, std::uint32_t 
             bool inside = true;
             for (std::size_t e = 0; e < extreme[a].size() && inside; ++e) {
                 const Vec3 o = extreme[a][e];
+                // The three rays' crossings at once, on all cores (a sum: the same on any).
+                using Hits = std::array<std::uint64_t, 3>;
+                const std::vector<std::uint32_t>& fb = facets[b];
+                const Hits hits = tbb::parallel_reduce(
+                    tbb::blocked_range<std::size_t>(0, fb.size(), kTreeGrain), Hits{},
+                    [&](const auto& r, Hits h) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                            const Triangle t = corners(fb[i]);
+                            for (std::size_t k = 0; k < rays.size(); ++k)
+                                h[k] += ray_crosses(o, rays[k], t);
+                        }
+                        return h;
+                    },
+                    [](Hits x, const Hits& y) {
+                        for (std::size_t k = 0; k < x.size(); ++k) x[k] += y[k];
+                        return x;
+                    });
                 int odd = 0;
-                for (const Vec3& d : rays) {
-                    std::uint64_t hits = 0;
-                    for (const std::uint32_t f : facets[b]) hits += ray_crosses(o, d, corners(f));
-                    odd += static_cast<int>(hits % 2);
-                }
+                for (const std::uint64_t h : hits) odd += static_cast<int>(h % 2);
                 inside = 2 * odd > static_cast<int>(rays.size());
             }
             if (inside) around[a].push_back(b);
