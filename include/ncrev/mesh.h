@@ -325,8 +325,10 @@ double default_weld_tolerance(const Box3& box, std::string* rule = nullptr);
 /// Facet pairs of one component of a mesh that cross each other (find_self_intersections()).
 struct SelfIntersectionReport {
     std::uint64_t pairs = 0;
-    Vec3 at{};             ///< where the pair of least facet indices crosses (pairs > 0)
-    bool complete = true;  ///< false past the work bound: then no pair is counted
+    Vec3 at{};  ///< where the pair of least facet indices crosses (pairs > 0)
+    /// False past the work bound (detail::kSelfIntersectionWork, a pile of facets over one
+    /// another): then no pair is counted.
+    bool complete = true;
 };
 
 /// Where `mesh` passes through itself: the facet pairs of one component that cross (a vertex

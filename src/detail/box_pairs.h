@@ -132,13 +132,13 @@ class BoxPairs {
             }
         });
         tbb::parallel_sort(keyed.begin(), keyed.end());
-        // The tree in heap order (node k's children 2k + 1, 2k + 2), leaves_ of them from
-        // first_leaf_ on: leaf l holds boxes [kLeaf l, kLeaf (l + 1)) of the curve's order;
-        // the slots past the last box are empty. Filled from the leaves up, a level at a time.
+        // The tree in heap order (node k's children 2k + 1, 2k + 2), its leaves (a power of
+        // two) from first_leaf_ on: leaf l holds boxes [kLeaf l, kLeaf (l + 1)) of the curve's
+        // order; the slots past the last box are empty. Filled from the leaves up, a level at a
+        // time.
         const std::uint32_t leaves = (n_ + kLeaf - 1) / kLeaf;
-        leaves_ = std::bit_ceil(leaves);
-        first_leaf_ = leaves_ - 1;
-        nodes_.assign(2 * std::size_t{leaves_} - 1, FloatBox{});
+        first_leaf_ = std::bit_ceil(leaves) - 1;
+        nodes_.assign(2 * std::size_t{first_leaf_} + 1, FloatBox{});
         detail::resize_huge(order_, n_);
         detail::resize_huge(slots_, leaves);
         tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, leaves, kGrain / kLeaf),
@@ -236,9 +236,8 @@ class BoxPairs {
         return mask;
     }
 
-    // The pairs of leaf nodes a and b that meet (of a leaf with itself, each once). Each box of
-    // a against all of b's at once, without a branch: on a mesh most tests meet (its facets'
-    // neighbours), and a mispredicted branch costs more than the test.
+    // The pairs of leaf nodes a and b that meet (of a leaf with itself, each once): each box
+    // of a against all of b's at once (meets_slots()), handed to fn as one batch.
     template <class Fn>
     void leaf_pairs(std::uint32_t a, std::uint32_t b, Fn& fn) const {
         std::array<Pair, kLeaf * kLeaf> batch;  // left uninitialized: written before read
@@ -303,7 +302,7 @@ class BoxPairs {
     }
 
     std::uint32_t n_ = 0;
-    std::uint32_t leaves_ = 0, first_leaf_ = 0;
+    std::uint32_t first_leaf_ = 0;
     std::vector<std::uint32_t> order_;  // box indices along the curve
     std::vector<Slots> slots_;          // their boxes, grown, kLeaf to a leaf
     std::vector<FloatBox> nodes_;

@@ -21,6 +21,7 @@
 #include "detail/nesting.h"
 #include "detail/triangle_tree.h"
 #include "ncrev/common.h"
+#include "ncrev/mesh.h"
 
 namespace ncrev::detail {
 
@@ -35,16 +36,6 @@ inline constexpr std::uint64_t kSelfIntersectionWork = 400'000'000;
 inline constexpr std::uint64_t kWorkFlush = 1u << 16;
 
 inline constexpr std::uint32_t kNoFacet = 0xffffffffu;
-
-struct SelfIntersections {
-    /// Facet pairs of one component that cross each other (see self_intersections()).
-    std::uint64_t pairs = 0;
-    /// False when the work bound (kSelfIntersectionWork) stopped the check: then no pair is
-    /// counted.
-    bool complete = true;
-    /// Where the crossing pair of least indices meets.
-    Vec3 at{};
-};
 
 /// The point where segment pq meets the plane of triangle t (pq not parallel to it).
 inline Vec3 plane_crossing(Vec3 p, Vec3 q, const Triangle& t) {
@@ -186,9 +177,10 @@ bool facets_cross(const Triangle& u, const std::array<std::uint32_t, 3>& iu, std
 /// whose boxes, grown by `tol`, meet are found by BoxPairs; past kSelfIntersectionWork of them
 /// the check stops, incomplete. Deterministic on any thread count.
 template <class Corners, class Ids, class Across>
-SelfIntersections self_intersections(std::span<const std::uint32_t> component, double tol,
-                                     const Corners& corners, const Ids& ids, const Across& across) {
-    SelfIntersections out;
+SelfIntersectionReport self_intersections(std::span<const std::uint32_t> component, double tol,
+                                          const Corners& corners, const Ids& ids,
+                                          const Across& across) {
+    SelfIntersectionReport out;
     const auto nf = static_cast<std::uint32_t>(component.size());
     if (nf < 2) return out;
     const auto box = [&](std::uint32_t f) { return box_of(corners(f)); };
@@ -250,7 +242,7 @@ SelfIntersections self_intersections(std::span<const std::uint32_t> component, d
             least = t;
         }
     }
-    if (stopped) return SelfIntersections{0, false, {}};
+    if (stopped) return SelfIntersectionReport{0, {}, false};
     out.at = least.at;
     return out;
 }

@@ -1217,9 +1217,7 @@ SelfIntersectionReport find_self_intersections(const Mesh& m, double tolerance, 
         vids = ids(g);
         return true;
     };
-    const detail::SelfIntersections crossed =
-        detail::self_intersections(face_components(m).of_face, tolerance, corners, ids, across);
-    return SelfIntersectionReport{crossed.pairs, crossed.at, crossed.complete};
+    return detail::self_intersections(face_components(m).of_face, tolerance, corners, ids, across);
 }
 
 Result<BuildResult> build_mesh(const TriangleSoup& soup, const HealOptions& options,
