@@ -797,9 +797,9 @@ TEST(ReverseSurfaces, LetteringWallsAreExtrusionsNotArcs) {
 // bounded by the mesh edges of its border, not as its facets: the link rods' five (walls one
 // facet tall between tangent free-form faces, see TangentJunctionsOfFittedPiecesHaveEdges).
 // CTC 02's two were such faces until their tangent junctions took the curve midway between
-// their surfaces (TangentEdgesStayWithinTheMeshsDeflection). (The occt_screw's thread flanks,
-// 916 facets once, the cones of CTC 01 and CTC 05, and FTC 07's cylinder that BRepMesh could
-// not triangulate and its tori were such faces; they build now, see
+// their surfaces (FinelyMeshedIllConditionedCornersAndTangentEdgesHoldTheMesh). (The occt_screw's
+// thread flanks, 916 facets once, the cones of CTC 01 and CTC 05, and FTC 07's cylinder that
+// BRepMesh could not triangulate and its tori were such faces; they build now, see
 // ABandFaceThatFailsTakesItsOwnSeam and ACapRoundAConesApexGetsASeamAndADegeneratedEdge, and
 // for FTC 07 the exact-surface refinement in docs/segmentation.md.) Those faces are within the
 // chordal deflection like every other.
@@ -1707,35 +1707,19 @@ std::optional<Outcome> reverse_corpus_mesh(const char* name, const SampleOptions
     return reverse_part(made.value(), false, ReverseMethod::kAuto, tag);
 }
 
-// NIST FTC 10 meshed at 0.04 mm / 0.1 rad (139k facets), reversed once for the two tests
-// below; nullptr where the corpus file is missing.
-const Outcome* ftc10_fine() {
-    static const std::optional<Outcome> o = [] {
-        SampleOptions so;
-        so.deflection = 0.04;
-        so.angular_deflection = 0.1;
-        return reverse_corpus_mesh("nist_ftc_10_asme1_rb.stp", so, "ftc10_fine");
-    }();
-    return o ? &*o : nullptr;
-}
-
+// NIST FTC 10 meshed at 0.04 mm / 0.1 rad (139k facets), reversed once for what follows. (One
+// test, not two sharing the reversal: ctest runs each test in a process of its own, so two
+// tests reversed it twice, 2 x 38 s in Release and 2 x 230 s under the sanitizers.)
+//
 // A bore and the torus rounding its end touch along a circle round the bore's axis. The
 // tangency feet were taken from the bore (the tube of smaller radius), whose spine points along
-// that circle are one point: on FTC 10 at 139k facets they heaped up, OpenCASCADE's
-// interpolation threw through them, and the throw gave up every other curve of the chain. Four
-// regions fell back: a bore and a plane with "no edge curve", a cylinder and a torus whose
-// wires crossed themselves. The torus, whose spine runs along the circle, is now the tube there
-// (kStillSpine), a throw costs only the curve through the points that caused it, and a curve
-// through feet is held to 2 tolerances (kTouchTolerances): none.
-TEST(ReverseSurfaces, ABoreMeetsTheTorusRoundingItsEnd) {
-    const Outcome* o = ftc10_fine();
-    if (!o) GTEST_SKIP() << "no corpus file nist_ftc_10_asme1_rb.stp";
-    expect_solid(*o, "ftc10_fine");
-    for (const ReverseFallback& f : o->report.fallbacks)
-        ADD_FAILURE() << "region " << f.region << " (" << f.kind << "): " << f.reason;
-    expect_near_the_part(*o, "ftc10_fine");
-}
-
+// that circle are one point: at 139k facets they heaped up, OpenCASCADE's interpolation threw
+// through them, and the throw gave up every other curve of the chain. Four regions fell back: a
+// bore and a plane with "no edge curve", a cylinder and a torus whose wires crossed themselves.
+// The torus, whose spine runs along the circle, is now the tube there (kStillSpine), a throw
+// costs only the curve through the points that caused it, and a curve through feet is held to 2
+// tolerances (kTouchTolerances): none.
+//
 // FTC 10's one free-form face, a 20.8 mm2 blend among fillets, is one B-spline at the issue's
 // resolution. Meshed finer its pieces (tori, cones, a sphere) met loose neighbours they could
 // not take before they were three, and a group of fewer curved pieces is dropped: at 139k
@@ -1743,9 +1727,21 @@ TEST(ReverseSurfaces, ABoreMeetsTheTorusRoundingItsEnd) {
 // faces for 214), at 2.5e-4 x the part's size as ten analytic faces. A group too small to keep
 // now grows on past such a neighbour (merge_loose_pieces()): two B-splines, and the file's
 // tori.
-TEST(ReverseSurfaces, AFreeformBlendMeshedFinelyIsNotInAnalyticPieces) {
-    const Outcome* o = ftc10_fine();
+TEST(ReverseSurfaces, FinelyMeshedBoreRoundingsAndFreeFormBlendAreWhole) {
+    SampleOptions so;
+    so.deflection = 0.04;
+    so.angular_deflection = 0.1;
+    const std::optional<Outcome> o =
+        reverse_corpus_mesh("nist_ftc_10_asme1_rb.stp", so, "ftc10_fine");
     if (!o) GTEST_SKIP() << "no corpus file nist_ftc_10_asme1_rb.stp";
+    {
+        SCOPED_TRACE("a bore meets the torus rounding its end");
+        expect_solid(*o, "ftc10_fine");
+        for (const ReverseFallback& f : o->report.fallbacks)
+            ADD_FAILURE() << "region " << f.region << " (" << f.kind << "): " << f.reason;
+        expect_near_the_part(*o, "ftc10_fine");
+    }
+    SCOPED_TRACE("the free-form blend is not in analytic pieces");
     EXPECT_LE(static_cast<double>(o->report.faces), 1.05 * static_cast<double>(o->true_faces));
     const auto count = [](const auto& by_kind, const char* kind) {
         const auto it = by_kind.find(kind);
@@ -1755,61 +1751,40 @@ TEST(ReverseSurfaces, AFreeformBlendMeshedFinelyIsNotInAnalyticPieces) {
     EXPECT_GE(count(o->report.faces_by_kind, "bspline"), 1u);
 }
 
-#if defined(__SANITIZE_ADDRESS__)
-#define NCREV_UNDER_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define NCREV_UNDER_ASAN 1
-#endif
-#endif
-
 // NIST FTC 07 meshed 4 x finer than issue 8's tessellation (87.8k facets), reversed once for
-// the two tests below; nullptr where the corpus file is missing, and under AddressSanitizer:
-// 20 s in Release, past ctest's 300 s limit under the sanitizers in CI (what the two tests
-// assert is not run under them by any other test known).
-const Outcome* ftc07_fine() {
-#ifdef NCREV_UNDER_ASAN
-    return nullptr;
-#else
-    static const std::optional<Outcome> o = [] {
-        SampleOptions so;
-        so.relative_deflection = 2.5e-4;
-        so.angular_deflection = 0.1;
-        return reverse_corpus_mesh("nist_ftc_07_asme1_rd.stp", so, "ftc07_fine");
-    }();
-    return o ? &*o : nullptr;
-#endif
-}
-constexpr const char* kNoFtc07Fine =
-    "under AddressSanitizer (too slow), or no corpus file nist_ftc_07_asme1_rd.stp";
-
-// On FTC 07 at 87.8k facets, two edge fillets and their corner torus are nearly tangent to one
-// another and to the top plane, and their common point, solved 0.12 mm from the mesh vertex,
-// lay past one fillet's tangent line with the plane: that fillet's wire crossed itself, and so
-// did seven other regions' (8 fallbacks, 433 faces for 269). A corner of a face that still
-// crosses itself after every other remedy goes back to its mesh vertex (vertex_at): 1 fallback.
-// (Volume -0.0062 % of the exact solid's, then -0.0110 %, a trade taken for 257 -> 255 faces
-// (254 on one surface): two B-spline regions that each hold a tenth of a sphere took two plane
-// pieces of it, 39 and 11 facets, loose on it (widen_freeform() in segmentation). The sphere's
-// own surface would have been closer; those regions are the fault.)
-TEST(ReverseSurfaces, IllConditionedCornersGoBackToTheirMeshVertex) {
-    const Outcome* o = ftc07_fine();
-    if (!o) GTEST_SKIP() << kNoFtc07Fine;
-    expect_solid(*o, "ftc07_fine");
-    EXPECT_LE(o->report.fallbacks.size(), 1u);
-    EXPECT_LE(o->report.faces, o->true_faces);
-    EXPECT_NEAR(o->report.solid_volume, o->true_volume, 1.3e-4 * o->true_volume);
-}
-
-// The same mesh: tori rounding cylinders, each fitted a few hundredths of a millimetre off
-// tangency with its cylinder, so no point is on both. Their junctions' curves through the
-// points solved onto both were 0.17 mm (1.7 delta) off the surfaces, and BRepMesh, which
-// follows an edge's curves on its faces, put the tori's triangles 0.5 mm (4.97 delta) from
-// mesh vertices that were on the solid. Such a junction now takes the curve midway between the
-// two where that is nearer (0.015 mm): both ways within 0.46 delta.
-TEST(ReverseSurfaces, TangentEdgesStayWithinTheMeshsDeflection) {
-    const Outcome* o = ftc07_fine();
-    if (!o) GTEST_SKIP() << kNoFtc07Fine;
+// what follows (one test, as for FTC 10 above).
+//
+// Two edge fillets and their corner torus are nearly tangent to one another and to the top
+// plane, and their common point, solved 0.12 mm from the mesh vertex, lay past one fillet's
+// tangent line with the plane: that fillet's wire crossed itself, and so did seven other
+// regions' (8 fallbacks, 433 faces for 269). A corner of a face that still crosses itself after
+// every other remedy goes back to its mesh vertex (vertex_at): 1 fallback. (Volume -0.0062 % of
+// the exact solid's, then -0.0110 %, a trade taken for 257 -> 255 faces (254 on one surface):
+// two B-spline regions that each hold a tenth of a sphere took two plane pieces of it, 39 and
+// 11 facets, loose on it (widen_freeform() in segmentation). The sphere's own surface would
+// have been closer; those regions are the fault.)
+//
+// Tori rounding cylinders, each fitted a few hundredths of a millimetre off tangency with its
+// cylinder, so no point is on both. Their junctions' curves through the points solved onto both
+// were 0.17 mm (1.7 delta) off the surfaces, and BRepMesh, which follows an edge's curves on
+// its faces, put the tori's triangles 0.5 mm (4.97 delta) from mesh vertices that were on the
+// solid. Such a junction now takes the curve midway between the two where that is nearer
+// (0.015 mm): both ways within 0.46 delta.
+TEST(ReverseSurfaces, FinelyMeshedIllConditionedCornersAndTangentEdgesHoldTheMesh) {
+    SampleOptions so;
+    so.relative_deflection = 2.5e-4;
+    so.angular_deflection = 0.1;
+    const std::optional<Outcome> o =
+        reverse_corpus_mesh("nist_ftc_07_asme1_rd.stp", so, "ftc07_fine");
+    if (!o) GTEST_SKIP() << "no corpus file nist_ftc_07_asme1_rd.stp";
+    {
+        SCOPED_TRACE("ill-conditioned corners go back to their mesh vertex");
+        expect_solid(*o, "ftc07_fine");
+        EXPECT_LE(o->report.fallbacks.size(), 1u);
+        EXPECT_LE(o->report.faces, o->true_faces);
+        EXPECT_NEAR(o->report.solid_volume, o->true_volume, 1.3e-4 * o->true_volume);
+    }
+    SCOPED_TRACE("tangent edges stay within the mesh's deflection");
     expect_near_the_part(*o, "ftc07_fine");
     ASSERT_TRUE(o->report.deviation.has_value());
     EXPECT_LE(o->report.deviation->mesh_to_solid.max, o->deflection);

@@ -3102,9 +3102,9 @@ constexpr double kSnapRmsFloor = 1;
 /// is not on its surface to within the noise, as a face of the part is (a noisy region's RMS is
 /// the noise, somewhat less). It is not snapped: a cylinder piece of a free-form blend, whose
 /// values are no part's and whose snapped radius moves the edges it shares with its neighbours
-/// (ReverseSurfaces.TangentEdgesStayWithinTheMeshsDeflection fails when such pieces snap); a
-/// fillet strip that took a few vertices of its neighbour, whose radius and place trade off so
-/// that the points cannot tell a round radius from the true one.
+/// (ReverseSurfaces.FinelyMeshedIllConditionedCornersAndTangentEdgesHoldTheMesh fails when such
+/// pieces snap); a fillet strip that took a few vertices of its neighbour, whose radius and place
+/// trade off so that the points cannot tell a round radius from the true one.
 constexpr double kSnapFitNoise = 3;
 
 bool same_surface(const Surface& a, const Surface& b) {
