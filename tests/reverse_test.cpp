@@ -1709,7 +1709,7 @@ std::optional<Outcome> reverse_corpus_mesh(const char* name, const SampleOptions
 
 // NIST FTC 10 meshed at 0.04 mm / 0.1 rad (139k facets), reversed once for what follows. (One
 // test, not two sharing the reversal: ctest runs each test in a process of its own, so two
-// tests reversed it twice, 2 x 38 s in Release and 2 x 230 s under the sanitizers.)
+// tests reversed it twice, 38 s each in Release.)
 //
 // A bore and the torus rounding its end touch along a circle round the bore's axis. The
 // tangency feet were taken from the bore (the tube of smaller radius), whose spine points along

@@ -79,8 +79,7 @@ inline Pierce pierces(Vec3 p, Vec3 q, const Triangle& t, double tol) {
     if (!(p_off && q_off && (sp > 0) != (sq > 0))) return Pierce::kNo;
     const double len = std::sqrt(len2);
     n = (1 / len) * n;
-    const double dp = dot(p - t[0], n), dq = dot(q - t[0], n);
-    if (!((dp > tol && dq < -tol) || (dp < -tol && dq > tol))) return Pierce::kNo;
+    const double dp = sp / len, dq = sq / len;
     const Vec3 x = p + (dp / (dp - dq)) * (q - p);
     Pierce out = Pierce::kThrough;
     for (std::size_t i = 0; i < 3; ++i) {
