@@ -580,6 +580,36 @@ TEST(MeshBuild, SplitsStitchedCapsInsteadOfOpeningACrack) {
     EXPECT_EQ(built.mesh.validate(), "");
 }
 
+// A strip of caps: a sliver between an edge (a, b) and the finer polyline a, c1, c2, b of the
+// face beside it, filled with two zero-area facets, as BRepMesh makes them along curved edges
+// at fine angular deflections. The first cap (a, b, c2) has the second beyond a short edge;
+// the second (c2, c1, a) has the first beyond its long edge, and waits for it. Until the
+// forty-ninth session both were dropped ("not stitched in") and the cube had a hole.
+TEST(MeshBuild, SplitsAStripOfCapsInsteadOfOpeningACrack) {
+    auto m = test::cube();
+    const auto t = m.triangles[0];
+    const std::uint32_t a = t[0], b = t[1], x = t[2];
+    const Vec3 pa = m.points[a], pb = m.points[b];
+    m.points.push_back(pa + (1.0 / 3) * (pb - pa));
+    const auto c1 = static_cast<std::uint32_t>(m.points.size() - 1);
+    m.points.push_back(pa + (2.0 / 3) * (pb - pa));
+    const auto c2 = static_cast<std::uint32_t>(m.points.size() - 1);
+    m.triangles[0] = {a, c1, x};
+    m.triangles.push_back({c1, c2, x});
+    m.triangles.push_back({c2, b, x});
+    m.triangles.push_back({a, b, c2});
+    m.triangles.push_back({c2, c1, a});
+    auto built = build_ok(test::to_bucket(m));
+    EXPECT_EQ(built.heal.degenerate_facets_removed, 2u);
+    EXPECT_EQ(built.heal.caps_split, 2u);
+    const MeshStats s = compute_stats(built.mesh);
+    EXPECT_TRUE(s.closed);
+    EXPECT_EQ(s.faces, 16u);  // 12 + 2 (facet 0 in three) + 2 (the facet beyond a-b in three)
+    EXPECT_EQ(s.vertices, 10u);
+    EXPECT_NEAR(s.volume, 1.0, 1e-12);
+    EXPECT_EQ(built.mesh.validate(), "");
+}
+
 TEST(MeshBuild, FindsHolesAsBoundaryLoops) {
     auto m = test::cube();
     m.triangles.erase(m.triangles.begin() + 2, m.triangles.begin() + 4);  // the top square

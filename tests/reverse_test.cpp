@@ -1791,6 +1791,31 @@ TEST(ReverseSurfaces, FinelyMeshedIllConditionedCornersAndTangentEdgesHoldTheMes
     EXPECT_LE(o->report.deviation->solid_to_mesh.max, o->deflection);
 }
 
+// NIST CTC 03 meshed by BRepMesh at 0.05 rad (27k facets) has strips of zero-area facets
+// along its curved edges: slivers between a facet's edge and the finer polyline of the face
+// beside it, two or three caps side by side (the tessellation is closed). Healing dropped every
+// cap with a cap beside it as not stitched in, and 17 cracks stayed open: the part came back as
+// a planar surface model of 6736 faces. Each cap now goes into the facet beyond its long edge
+// (docs/healing.md 2): closed, and the part face for face.
+TEST(ReverseSurfaces, StripsOfCapsAlongCurvedEdgesKeepThePartClosed) {
+    SampleOptions so;
+    so.relative_deflection = 1e-4;
+    so.angular_deflection = 0.05;
+    const std::optional<Outcome> o =
+        reverse_corpus_mesh("nist_ctc_03_asme1_rc.stp", so, "ctc03_caps");
+    if (!o) GTEST_SKIP() << "no corpus file nist_ctc_03_asme1_rc.stp";
+    EXPECT_GT(o->heal.caps_split, 100u);
+    EXPECT_EQ(o->heal.caps_split, o->heal.degenerate_facets_removed);
+    EXPECT_EQ(o->heal.holes_filled, 0u);
+    EXPECT_TRUE(o->mesh.closed);
+    expect_solid(*o, "ctc03_caps");
+    EXPECT_EQ(o->report.faces, o->true_faces);
+    // One cone of 48 facets, beside a bore, fails once the STEP is read back and comes back on
+    // its surface bounded by its mesh edges (a lead of its own: docs/results.md).
+    EXPECT_LE(o->report.fallbacks.size(), 1u);
+    expect_near_the_part(*o, "ctc03_caps");
+}
+
 TEST(ReverseStudy, DISABLED_Corpus) {
     // THREADS=n: at most n threads (results must not depend on it).
     std::optional<tbb::global_control> threads;
