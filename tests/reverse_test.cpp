@@ -1791,6 +1791,28 @@ TEST(ReverseSurfaces, FinelyMeshedIllConditionedCornersAndTangentEdgesHoldTheMes
     EXPECT_LE(o->report.deviation->solid_to_mesh.max, o->deflection);
 }
 
+// NIST CTC 01 meshed at 0.05 mm and 0.05 rad (34.6k facets): a plane of two long thin facets
+// (2 x 22 mm) beside a small bore. One of them and a strip of the bore fitted a spindle torus
+// within the tolerance at every corner and at the facet's middle, but its long edges' middles
+// lay 0.91 mm off (ten tolerances): the face on the torus stood 1.24 mm (25 deflections) off
+// the mesh, in a valid solid of 140 faces. A chord's longest edge is now held too
+// (chords_agree()): the part face for face.
+TEST(ReverseSurfaces, ALongThinFacetIsNoChordOfATorusThroughItsCorners) {
+    SampleOptions so;
+    so.deflection = 0.05;
+    so.angular_deflection = 0.05;
+    const std::optional<Outcome> o =
+        reverse_corpus_mesh("nist_ctc_01_asme1_rd.stp", so, "ctc01_fine");
+    if (!o) GTEST_SKIP() << "no corpus file nist_ctc_01_asme1_rd.stp";
+    expect_solid(*o, "ctc01_fine");
+    EXPECT_EQ(o->report.faces, o->true_faces);
+    EXPECT_EQ(o->report.faces_by_kind.count("torus"), 0u);
+    EXPECT_TRUE(o->report.fallbacks.empty());
+    ASSERT_TRUE(o->report.deviation.has_value());
+    EXPECT_LE(o->report.deviation->solid_to_mesh.max, 2 * o->deflection);
+    EXPECT_LE(o->report.deviation->mesh_to_solid.max, 2 * o->deflection);
+}
+
 // NIST CTC 03 meshed by BRepMesh at 0.05 rad (27k facets) has strips of zero-area facets
 // along its curved edges: slivers between a facet's edge and the finer polyline of the face
 // beside it, two or three caps side by side (the tessellation is closed). Healing dropped every
