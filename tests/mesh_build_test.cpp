@@ -610,6 +610,29 @@ TEST(MeshBuild, SplitsAStripOfCapsInsteadOfOpeningACrack) {
     EXPECT_EQ(built.mesh.validate(), "");
 }
 
+// Two caps over each other hanging off a closed cube's edge (a, b): a fin of zero area, one cap
+// running a -> b as the cube's facet there does. Neither is stitched in: both go and the cube
+// stays as it was. Splitting the facet beyond the first cap's long edge would leave its
+// pieces' edges to the second cap, which goes: a crack where there was none.
+TEST(MeshBuild, AFinOfCapsOffAnEdgeIsDroppedAndSplitsNothing) {
+    auto m = test::cube();
+    const auto t = m.triangles[0];
+    const std::uint32_t a = t[0], b = t[1];
+    m.points.push_back(0.5 * (m.points[a] + m.points[b]));
+    const auto c = static_cast<std::uint32_t>(m.points.size() - 1);
+    m.triangles.push_back({b, a, c});
+    m.triangles.push_back({a, b, c});
+    auto built = build_ok(test::to_bucket(m));
+    EXPECT_EQ(built.heal.degenerate_facets_removed, 2u);
+    EXPECT_EQ(built.heal.caps_split, 0u);
+    const MeshStats s = compute_stats(built.mesh);
+    EXPECT_TRUE(s.closed);
+    EXPECT_EQ(s.faces, 12u);
+    EXPECT_EQ(s.vertices, 8u);
+    EXPECT_NEAR(s.volume, 1.0, 1e-12);
+    EXPECT_EQ(built.mesh.validate(), "");
+}
+
 TEST(MeshBuild, FindsHolesAsBoundaryLoops) {
     auto m = test::cube();
     m.triangles.erase(m.triangles.begin() + 2, m.triangles.begin() + 4);  // the top square

@@ -484,29 +484,62 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
         // Directed edge -> kept slot, for the edges between two caps' vertices only: every
         // edge looked up or erased below is one (a cap's three; entries for other edges would
         // be written and never read), and the map of all edges was most of healing on a mesh
-        // of a million facets with a few caps (3.7 s, 0.5 s without it). The caps' own edges
-        // first, so that a sound facet on the same directed edge takes it.
+        // of a million facets with a few caps (3.7 s, 0.5 s without it). A cap that runs a
+        // directed edge another facet runs too (a cap over a cap, a fin hanging off an edge)
+        // is not stitched in: `loose`.
         std::vector<std::uint8_t> at_cap(vpos.size(), 0);
         for (std::size_t k : caps) {
             for (const std::uint32_t v : tri[kept[k]]) at_cap[v] = 1;
         }
+        std::unordered_map<std::size_t, std::uint32_t> cap_index;
+        for (std::size_t i = 0; i < caps.size(); ++i)
+            cap_index.emplace(caps[i], static_cast<std::uint32_t>(i));
+        std::vector<std::uint8_t> loose(caps.size(), 0);
         std::unordered_map<std::uint64_t, std::size_t> owner;
         const auto own = [&](std::uint32_t u, std::uint32_t v, std::size_t k) {
             if (at_cap[u] && at_cap[v]) owner[key(u, v)] = k;
         };
-        for (std::size_t k : caps) {
-            const auto& t = tri[kept[k]];
-            for (int i = 0; i < 3; ++i) own(t[i], t[(i + 1) % 3], k);
+        for (std::size_t i = 0; i < caps.size(); ++i) {
+            const auto& t = tri[kept[caps[i]]];
+            for (int j = 0; j < 3; ++j) {
+                const auto [it, added] = owner.emplace(key(t[j], t[(j + 1) % 3]), caps[i]);
+                if (!added) loose[i] = loose[cap_index.at(it->second)] = 1;
+            }
         }
         for (std::size_t k = 0; k < kept.size(); ++k) {
             if (bad[k]) continue;
             const auto& t = tri[kept[k]];
-            for (int i = 0; i < 3; ++i) own(t[i], t[(i + 1) % 3], k);
+            for (int i = 0; i < 3; ++i) {
+                const std::uint32_t u = t[i], v = t[(i + 1) % 3];
+                if (!at_cap[u] || !at_cap[v]) continue;
+                const auto it = owner.find(key(u, v));
+                if (it != owner.end() && bad[it->second]) loose[cap_index.at(it->second)] = 1;
+                own(u, v, k);
+            }
         }
+        // Caps side by side are one sliver, split in only when it is stitched in all round:
+        // every edge of its caps has a cap of it or a sound facet beyond, and none is loose.
+        // (A fin of two caps hanging off an edge would otherwise split the facet there and open
+        // it where the fin goes.)
+        detail::MinUnionFind sliver(caps.size());
+        for (std::size_t i = 0; i < caps.size(); ++i) {
+            const auto& t = tri[kept[caps[i]]];
+            for (int j = 0; j < 3; ++j) {
+                const auto beyond = owner.find(key(t[(j + 1) % 3], t[j]));
+                if (beyond == owner.end()) {
+                    loose[i] = 1;
+                } else if (bad[beyond->second]) {
+                    sliver.unite(static_cast<std::uint32_t>(i), cap_index.at(beyond->second));
+                }
+            }
+        }
+        for (std::size_t i = 0; i < caps.size(); ++i)
+            if (loose[i]) loose[sliver.find(static_cast<std::uint32_t>(i))] = 1;
         // Caps waiting for the cap beyond their long edge (its slot -> theirs).
         std::unordered_map<std::size_t, std::vector<std::size_t>> waiting;
         std::vector<std::size_t> ready;
-        for (auto cap = caps.rbegin(); cap != caps.rend(); ++cap) ready.push_back(*cap);
+        for (std::size_t i = caps.size(); i-- > 0;)
+            if (!loose[sliver.find(static_cast<std::uint32_t>(i))]) ready.push_back(caps[i]);
         while (!ready.empty()) {
             const std::size_t k = ready.back();
             ready.pop_back();
