@@ -467,10 +467,10 @@ Result<BuildResult> MeshBuilder::build(const TriangleSoup& soup, TriangleSoup* o
     // tessellations make such caps where a face's boundary has a vertex in the middle of the
     // neighbouring face's edge. They also make strips of them, a sliver between a chord and
     // the finer polyline of a curved edge (BRepMesh on NIST FTC 06 at 1e-4 of its size and
-    // 0.03 rad: 815k facets, closed, 420 caps): a cap beyond another's short edge counts as
-    // stitched, and a cap beyond another's long edge waits until that one has gone, its
-    // split facet then beyond it (until the forty-ninth session each was dropped and the
-    // closed mesh had 83 holes).
+    // 0.03 rad: 815k facets, closed, 420 caps). Caps side by side are one sliver, split in
+    // when it is stitched in all round, and a cap beyond another's long edge waits until that
+    // one has gone, its split facet then beyond it (until the forty-ninth session every cap
+    // with a cap beside it was dropped, and that closed mesh had 83 holes).
     const auto split_caps = [&](std::vector<std::uint8_t>& bad) {
         std::vector<std::size_t> caps;
         for (std::size_t k = 0; k < kept.size(); ++k) {
