@@ -555,6 +555,21 @@ TEST(MeshBuild, RemovesDegenerateFacets) {
     EXPECT_TRUE(s.closed);
 }
 
+/// The unit cube `m` with caps added, healed: `removed` facets dropped, `split` caps split in,
+/// and a closed unit cube of `faces` facets and `vertices` vertices left.
+void expect_healed_cube(const test::Indexed& m, std::uint64_t removed, std::uint64_t split,
+                        std::size_t faces, std::size_t vertices) {
+    auto built = build_ok(test::to_bucket(m));
+    EXPECT_EQ(built.heal.degenerate_facets_removed, removed);
+    EXPECT_EQ(built.heal.caps_split, split);
+    const MeshStats s = compute_stats(built.mesh);
+    EXPECT_TRUE(s.closed);
+    EXPECT_EQ(s.faces, faces);
+    EXPECT_EQ(s.vertices, vertices);
+    EXPECT_NEAR(s.volume, 1.0, 1e-12);
+    EXPECT_EQ(built.mesh.validate(), "");
+}
+
 // A cap stitched into the surface (a T-junction's zero-area facet, as CAD tessellations make
 // them) is removed by splitting the facet beyond its long edge: no crack opens.
 TEST(MeshBuild, SplitsStitchedCapsInsteadOfOpeningACrack) {
@@ -569,15 +584,8 @@ TEST(MeshBuild, SplitsStitchedCapsInsteadOfOpeningACrack) {
     m.triangles[0] = {a, c, x};
     m.triangles.push_back({c, b, x});
     m.triangles.push_back({a, b, c});
-    auto built = build_ok(test::to_bucket(m));
-    EXPECT_EQ(built.heal.degenerate_facets_removed, 1u);
-    EXPECT_EQ(built.heal.caps_split, 1u);
-    const MeshStats s = compute_stats(built.mesh);
-    EXPECT_TRUE(s.closed);
-    EXPECT_EQ(s.faces, 14u);  // 12 + 1 (facet 0 split) + 1 (the facet beyond a-b split)
-    EXPECT_EQ(s.vertices, 9u);
-    EXPECT_NEAR(s.volume, 1.0, 1e-12);
-    EXPECT_EQ(built.mesh.validate(), "");
+    // 12 + 1 (facet 0 split) + 1 (the facet beyond a-b split)
+    expect_healed_cube(m, 1, 1, 14, 9);
 }
 
 // A strip of caps: a sliver between an edge (a, b) and the finer polyline a, c1, c2, b of the
@@ -599,15 +607,8 @@ TEST(MeshBuild, SplitsAStripOfCapsInsteadOfOpeningACrack) {
     m.triangles.push_back({c2, b, x});
     m.triangles.push_back({a, b, c2});
     m.triangles.push_back({c2, c1, a});
-    auto built = build_ok(test::to_bucket(m));
-    EXPECT_EQ(built.heal.degenerate_facets_removed, 2u);
-    EXPECT_EQ(built.heal.caps_split, 2u);
-    const MeshStats s = compute_stats(built.mesh);
-    EXPECT_TRUE(s.closed);
-    EXPECT_EQ(s.faces, 16u);  // 12 + 2 (facet 0 in three) + 2 (the facet beyond a-b in three)
-    EXPECT_EQ(s.vertices, 10u);
-    EXPECT_NEAR(s.volume, 1.0, 1e-12);
-    EXPECT_EQ(built.mesh.validate(), "");
+    // 12 + 2 (facet 0 in three) + 2 (the facet beyond a-b in three)
+    expect_healed_cube(m, 2, 2, 16, 10);
 }
 
 // Two caps over each other hanging off a closed cube's edge (a, b): a fin of zero area, one cap
@@ -622,15 +623,7 @@ TEST(MeshBuild, AFinOfCapsOffAnEdgeIsDroppedAndSplitsNothing) {
     const auto c = static_cast<std::uint32_t>(m.points.size() - 1);
     m.triangles.push_back({b, a, c});
     m.triangles.push_back({a, b, c});
-    auto built = build_ok(test::to_bucket(m));
-    EXPECT_EQ(built.heal.degenerate_facets_removed, 2u);
-    EXPECT_EQ(built.heal.caps_split, 0u);
-    const MeshStats s = compute_stats(built.mesh);
-    EXPECT_TRUE(s.closed);
-    EXPECT_EQ(s.faces, 12u);
-    EXPECT_EQ(s.vertices, 8u);
-    EXPECT_NEAR(s.volume, 1.0, 1e-12);
-    EXPECT_EQ(built.mesh.validate(), "");
+    expect_healed_cube(m, 2, 0, 12, 8);
 }
 
 TEST(MeshBuild, FindsHolesAsBoundaryLoops) {
