@@ -535,7 +535,8 @@ bool chords_agree(const Context& c, const Surface& s, std::span<const std::uint3
             beyond = true;
         }
         // Its longest edge's middle: within what a facet's middle may sag when growing
-        // (facet_cost()), and the factor by which an edge's can sag more.
+        // (facet_cost()), and the factor by which an edge's can sag more. (Not on a B-spline,
+        // whose chords are held to how far it bends between their corners, above.)
         if (s.kind != FitKind::kBSpline &&
             longest_edge_middle_off(c, s, f) > kEdgeMiddleFactor * kMiddleSagFactor * c.sag)
             return false;
