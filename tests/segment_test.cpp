@@ -834,17 +834,14 @@ TEST(Segment, DraftedWallsOfACorpusPartAreCones) {
     EXPECT_LE(r.regions.size(), 540u);
 }
 
-// Real parts: each corpus STEP solid tessellated at 1e-3 of its size (as issue 8 asks), the
-// default method against its faces. docs/segmentation.md, "Real parts":
-//   build/bin/ncrev_tests --gtest_also_run_disabled_tests --gtest_filter='SegmentStudy.*Corpus'
 // NIST CTC 03 is 86 planes and 53 cylinders. Meshed at 2e-5 x its size and 0.02 rad (68k
 // facets), growing took into its large planes the rows of the fillets tangent to them that lie
 // within the tolerance; those rows pulled each plane's least-squares fit off its own facets by
 // more than a firm plane allows (kFirmPlaneShare), and at the next ring six planes became
-// cones of half-angle 0.02-0.34 degrees and radius 3.7-5.4 m. Merging then fitted every union with
-// their neighbours as such a cone (2.5 s), and two small planes came back as cones. A plane is
-// now firm on the plane of its nearest facets when the rest hold a few percent of its area
-// (firm_plane()): one region a cone, the other planes planes.
+// cones of half-angle 0.02-0.34 degrees and radius 3.7-5.4 m. Merging then fitted every union
+// with their neighbours as such a cone (2.5 s), and two small planes came back as cones. A
+// plane is now firm on the plane of its nearest facets when the rest hold a few percent of its
+// area (firm_plane()): one region a cone, the other planes planes.
 TEST(Segment, PlanesWithTangentFilletRowsStayPlanes) {
     const auto dir = corpus_step_dir();
     if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no corpus at " << dir;
@@ -880,6 +877,9 @@ TEST(Segment, PlanesWithTangentFilletRowsStayPlanes) {
     EXPECT_LE(wrong, 1u) << "regions of another kind than their true face's";
 }
 
+// Real parts: each corpus STEP solid tessellated at 1e-3 of its size (as issue 8 asks), the
+// default method against its faces. docs/segmentation.md, "Real parts":
+//   build/bin/ncrev_tests --gtest_also_run_disabled_tests --gtest_filter='SegmentStudy.*Corpus'
 TEST(SegmentStudy, DISABLED_Corpus) {
     std::printf(
         "| file | facets | true faces | IoU | regions | kind | s |\n"
